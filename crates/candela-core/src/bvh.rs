@@ -1,0 +1,418 @@
+//! A bounding volume hierarchy over primitive boxes, built with the binned surface area
+//! heuristic (Wald 2007, "On fast Construction of SAH-based Bounding Volume Hierarchies").
+//!
+//! The BVH knows nothing of triangles or spheres: traversal calls a closure with the index
+//! of each primitive whose box the ray enters, so any primitive type can sit in it.
+
+use glam::Vec3;
+
+use crate::geometry::{Aabb, Ray};
+
+const BINS: usize = 16;
+const MAX_LEAF: usize = 4;
+/// Cost of one traversal step relative to one primitive test.
+const TRAVERSAL_COST: f32 = 1.0;
+/// Subtrees larger than this are built in parallel.
+const PARALLEL_THRESHOLD: usize = 4096;
+
+/// A node of the flattened tree. An interior node's first child follows it directly and
+/// `offset` is its second child; a leaf holds `count` primitives from `offset` on.
+#[derive(Clone, Copy, Debug)]
+pub struct BvhNode {
+    pub bounds: Aabb,
+    pub offset: u32,
+    pub count: u16,
+    pub axis: u8,
+}
+
+impl BvhNode {
+    pub fn is_leaf(&self) -> bool {
+        self.count > 0
+    }
+}
+
+#[derive(Clone, Debug, Default)]
+pub struct Bvh {
+    pub nodes: Vec<BvhNode>,
+    /// Primitive indices in leaf order.
+    pub prims: Vec<u32>,
+}
+
+enum BuildNode {
+    Leaf {
+        bounds: Aabb,
+        first: usize,
+        count: usize,
+    },
+    Interior {
+        bounds: Aabb,
+        axis: u8,
+        children: Box<[BuildNode; 2]>,
+        size: usize,
+    },
+}
+
+impl BuildNode {
+    fn node_count(&self) -> usize {
+        match self {
+            BuildNode::Leaf { .. } => 1,
+            BuildNode::Interior { size, .. } => *size,
+        }
+    }
+}
+
+#[derive(Clone, Copy)]
+struct PrimInfo {
+    bounds: Aabb,
+    centroid: Vec3,
+    index: u32,
+}
+
+impl Bvh {
+    /// Builds a BVH over primitives with the given boxes. Primitives with empty or
+    /// non-finite boxes are left out: no ray can hit them.
+    pub fn build(boxes: &[Aabb]) -> Bvh {
+        let mut infos: Vec<PrimInfo> = boxes
+            .iter()
+            .enumerate()
+            .filter(|(_, b)| !b.is_empty() && b.min.is_finite() && b.max.is_finite())
+            .map(|(i, b)| PrimInfo {
+                bounds: *b,
+                centroid: b.center(),
+                index: i as u32,
+            })
+            .collect();
+        if infos.is_empty() {
+            return Bvh::default();
+        }
+        let root = build_recursive(&mut infos, 0);
+        let mut bvh = Bvh {
+            nodes: Vec::with_capacity(root.node_count()),
+            prims: infos.iter().map(|p| p.index).collect(),
+        };
+        bvh.flatten(&root);
+        bvh
+    }
+
+    fn flatten(&mut self, node: &BuildNode) {
+        match node {
+            BuildNode::Leaf {
+                bounds,
+                first,
+                count,
+            } => self.nodes.push(BvhNode {
+                bounds: *bounds,
+                offset: *first as u32,
+                count: *count as u16,
+                axis: 0,
+            }),
+            BuildNode::Interior {
+                bounds,
+                axis,
+                children,
+                ..
+            } => {
+                let at = self.nodes.len();
+                self.nodes.push(BvhNode {
+                    bounds: *bounds,
+                    offset: 0,
+                    count: 0,
+                    axis: *axis,
+                });
+                self.flatten(&children[0]);
+                self.nodes[at].offset = self.nodes.len() as u32;
+                self.flatten(&children[1]);
+            }
+        }
+    }
+
+    pub fn bounds(&self) -> Aabb {
+        self.nodes.first().map_or(Aabb::EMPTY, |n| n.bounds)
+    }
+
+    /// Finds the nearest hit. `hit(prim, t_max)` tests primitive `prim` and returns its
+    /// distance if it is hit before `t_max`; the search then narrows to that distance.
+    /// Returns the nearest primitive and its distance.
+    #[inline]
+    pub fn intersect(
+        &self,
+        ray: &Ray,
+        t_max: f32,
+        mut hit: impl FnMut(u32, f32) -> Option<f32>,
+    ) -> Option<(u32, f32)> {
+        let mut best = None;
+        self.traverse(
+            ray,
+            |prim, t_max| match hit(prim, t_max) {
+                Some(t) if t < t_max => {
+                    best = Some((prim, t));
+                    (t, false)
+                }
+                _ => (t_max, false),
+            },
+            t_max,
+        );
+        best
+    }
+
+    /// Whether any primitive blocks the ray before `t_max`; stops at the first one found.
+    #[inline]
+    pub fn occluded(
+        &self,
+        ray: &Ray,
+        t_max: f32,
+        mut blocks: impl FnMut(u32, f32) -> bool,
+    ) -> bool {
+        let mut found = false;
+        self.traverse(
+            ray,
+            |prim, t| {
+                found = blocks(prim, t);
+                (t, found)
+            },
+            t_max,
+        );
+        found
+    }
+
+    /// Visits leaves front to back; `visit(prim, t_max)` returns the new `t_max` and
+    /// whether to stop.
+    #[inline]
+    fn traverse(&self, ray: &Ray, mut visit: impl FnMut(u32, f32) -> (f32, bool), mut t_max: f32) {
+        if self.nodes.is_empty() {
+            return;
+        }
+        let inv_d = ray.d.recip();
+        let neg = [inv_d.x < 0.0, inv_d.y < 0.0, inv_d.z < 0.0];
+        let mut stack = [0u32; 64];
+        let mut sp = 0usize;
+        let mut current = 0usize;
+        loop {
+            let node = &self.nodes[current];
+            if node.bounds.hit(ray.o, inv_d, t_max).is_some() {
+                if node.is_leaf() {
+                    let first = node.offset as usize;
+                    for &prim in &self.prims[first..first + node.count as usize] {
+                        let (t, stop) = visit(prim, t_max);
+                        if stop {
+                            return;
+                        }
+                        t_max = t;
+                    }
+                } else {
+                    // Visit the child on the ray's near side first.
+                    let (near, far) = if neg[node.axis as usize] {
+                        (node.offset as usize, current + 1)
+                    } else {
+                        (current + 1, node.offset as usize)
+                    };
+                    stack[sp] = far as u32;
+                    sp += 1;
+                    current = near;
+                    continue;
+                }
+            }
+            if sp == 0 {
+                return;
+            }
+            sp -= 1;
+            current = stack[sp] as usize;
+        }
+    }
+}
+
+fn build_recursive(prims: &mut [PrimInfo], first: usize) -> BuildNode {
+    let bounds = prims.iter().fold(Aabb::EMPTY, |b, p| b.union(p.bounds));
+    let n = prims.len();
+    let leaf = BuildNode::Leaf {
+        bounds,
+        first,
+        count: n,
+    };
+    if n <= 1 {
+        return leaf;
+    }
+    let centroids = prims.iter().fold(Aabb::EMPTY, |b, p| b.grow(p.centroid));
+    let extent = centroids.extent();
+    let axis = extent.max_position();
+    if extent[axis] <= 0.0 {
+        // All centroids coincide: no split separates them.
+        return if n <= MAX_LEAF {
+            leaf
+        } else {
+            split_middle(prims, first, bounds, axis)
+        };
+    }
+
+    // Bin centroids along the widest axis and sweep for the cheapest SAH split.
+    let scale = BINS as f32 / extent[axis];
+    let bin_of =
+        |p: &PrimInfo| (((p.centroid[axis] - centroids.min[axis]) * scale) as usize).min(BINS - 1);
+    let mut bin_bounds = [Aabb::EMPTY; BINS];
+    let mut bin_counts = [0usize; BINS];
+    for p in prims.iter() {
+        let b = bin_of(p);
+        bin_counts[b] += 1;
+        bin_bounds[b] = bin_bounds[b].union(p.bounds);
+    }
+    let mut right_area = [0.0f32; BINS];
+    let mut right_count = [0usize; BINS];
+    let (mut acc, mut count) = (Aabb::EMPTY, 0);
+    for i in (1..BINS).rev() {
+        acc = acc.union(bin_bounds[i]);
+        count += bin_counts[i];
+        right_area[i] = acc.surface_area();
+        right_count[i] = count;
+    }
+    let (mut best_cost, mut best_split) = (f32::INFINITY, 0);
+    let (mut acc, mut count) = (Aabb::EMPTY, 0);
+    for i in 0..BINS - 1 {
+        acc = acc.union(bin_bounds[i]);
+        count += bin_counts[i];
+        if count == 0 || right_count[i + 1] == 0 {
+            continue;
+        }
+        let cost =
+            count as f32 * acc.surface_area() + right_count[i + 1] as f32 * right_area[i + 1];
+        if cost < best_cost {
+            best_cost = cost;
+            best_split = i;
+        }
+    }
+    let leaf_cost = n as f32;
+    let split_cost = TRAVERSAL_COST + best_cost / bounds.surface_area().max(f32::MIN_POSITIVE);
+    if n <= MAX_LEAF && leaf_cost <= split_cost {
+        return leaf;
+    }
+    if !best_cost.is_finite() {
+        return split_middle(prims, first, bounds, axis);
+    }
+    let mid = partition(prims, |p| bin_of(p) <= best_split);
+    make_interior(prims, first, bounds, axis, mid)
+}
+
+fn split_middle(prims: &mut [PrimInfo], first: usize, bounds: Aabb, axis: usize) -> BuildNode {
+    let mid = prims.len() / 2;
+    prims.select_nth_unstable_by(mid, |a, b| a.centroid[axis].total_cmp(&b.centroid[axis]));
+    make_interior(prims, first, bounds, axis, mid)
+}
+
+fn make_interior(
+    prims: &mut [PrimInfo],
+    first: usize,
+    bounds: Aabb,
+    axis: usize,
+    mid: usize,
+) -> BuildNode {
+    let n = prims.len();
+    let (left, right) = prims.split_at_mut(mid);
+    let (a, b) = if n > PARALLEL_THRESHOLD {
+        rayon::join(
+            || build_recursive(left, first),
+            || build_recursive(right, first + mid),
+        )
+    } else {
+        (
+            build_recursive(left, first),
+            build_recursive(right, first + mid),
+        )
+    };
+    let size = 1 + a.node_count() + b.node_count();
+    BuildNode::Interior {
+        bounds,
+        axis: axis as u8,
+        children: Box::new([a, b]),
+        size,
+    }
+}
+
+fn partition(prims: &mut [PrimInfo], pred: impl Fn(&PrimInfo) -> bool) -> usize {
+    let mut i = 0;
+    for j in 0..prims.len() {
+        if pred(&prims[j]) {
+            prims.swap(i, j);
+            i += 1;
+        }
+    }
+    i
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::sampler::Pcg32;
+
+    fn random_boxes(n: usize, rng: &mut Pcg32) -> Vec<Aabb> {
+        (0..n)
+            .map(|_| {
+                let c = Vec3::new(rng.uniform_f32(), rng.uniform_f32(), rng.uniform_f32()) * 10.0;
+                let e = Vec3::new(rng.uniform_f32(), rng.uniform_f32(), rng.uniform_f32()) * 0.3;
+                Aabb {
+                    min: c - e,
+                    max: c + e,
+                }
+            })
+            .collect()
+    }
+
+    #[test]
+    fn finds_the_same_nearest_box_as_brute_force() {
+        let mut rng = Pcg32::new(11, 0);
+        let boxes = random_boxes(5000, &mut rng);
+        let bvh = Bvh::build(&boxes);
+        let mut seen: Vec<u32> = bvh.prims.clone();
+        seen.sort();
+        assert_eq!(
+            seen,
+            (0..5000).collect::<Vec<_>>(),
+            "every primitive sits in one leaf"
+        );
+        for _ in 0..2000 {
+            let o = Vec3::new(rng.uniform_f32(), rng.uniform_f32(), rng.uniform_f32()) * 12.0 - 1.0;
+            let d = (Vec3::new(rng.uniform_f32(), rng.uniform_f32(), rng.uniform_f32()) - 0.5)
+                .normalize();
+            let ray = Ray::new(o, d);
+            let inv = d.recip();
+            let box_t = |i: u32, t_max: f32| boxes[i as usize].hit(o, inv, t_max);
+            let brute = (0..boxes.len() as u32)
+                .filter_map(|i| box_t(i, f32::INFINITY).map(|t| (i, t)))
+                .min_by(|a, b| a.1.total_cmp(&b.1));
+            let found = bvh.intersect(&ray, f32::INFINITY, box_t);
+            assert_eq!(found.map(|f| f.1), brute.map(|b| b.1));
+            assert_eq!(
+                bvh.occluded(&ray, f32::INFINITY, |i, t| box_t(i, t).is_some()),
+                brute.is_some()
+            );
+        }
+    }
+
+    #[test]
+    fn degenerate_input_builds() {
+        assert!(Bvh::build(&[]).nodes.is_empty());
+        let same = vec![
+            Aabb {
+                min: Vec3::ZERO,
+                max: Vec3::ONE
+            };
+            100
+        ];
+        let bvh = Bvh::build(&same);
+        assert_eq!(bvh.prims.len(), 100);
+        let bad = [
+            Aabb::EMPTY,
+            Aabb {
+                min: Vec3::splat(f32::NAN),
+                max: Vec3::ONE,
+            },
+            Aabb {
+                min: Vec3::ZERO,
+                max: Vec3::ZERO,
+            },
+        ];
+        assert_eq!(
+            Bvh::build(&bad).prims,
+            vec![2],
+            "empty and NaN boxes are left out; a flat box stays"
+        );
+    }
+}

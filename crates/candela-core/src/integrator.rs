@@ -1,0 +1,261 @@
+//! The path tracer: next event estimation towards one light chosen by the scene's
+//! [`crate::light_sampler::LightSampler`], BSDF sampling, and the two combined by multiple
+//! importance sampling (Veach 1997, ch. 9), with Russian roulette on the throughput.
+
+use std::ops::Range;
+use std::sync::atomic::{AtomicBool, Ordering};
+
+use glam::{UVec2, Vec2, Vec3};
+use rayon::prelude::*;
+
+use crate::bsdf::Bsdf;
+use crate::desc::MisMode;
+use crate::film::{Film, Pixel};
+use crate::geometry::Ray;
+use crate::light::{LightId, ShadingCtx};
+use crate::math::max_component;
+use crate::sampler::{IndependentSampler, Sampler};
+use crate::sampling::{balance_heuristic, power_heuristic};
+use crate::scene::{Scene, SurfaceInteraction};
+
+/// Rows per parallel work item.
+const BAND_ROWS: usize = 4;
+/// Russian roulette starts after this many bounces.
+const RR_MIN_DEPTH: u32 = 3;
+
+/// Counters of one render.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct RenderStats {
+    /// Camera paths traced.
+    pub paths: u64,
+    /// Rays cast: camera, bounce and shadow rays.
+    pub rays: u64,
+}
+
+impl RenderStats {
+    fn add(self, o: RenderStats) -> RenderStats {
+        RenderStats {
+            paths: self.paths + o.paths,
+            rays: self.rays + o.rays,
+        }
+    }
+}
+
+/// What a render produced: the film (possibly partial) and its counters.
+#[derive(Clone, Debug)]
+pub struct RenderResult {
+    pub film: Film,
+    pub stats: RenderStats,
+    /// Whether the cancel flag stopped the render before all samples were taken.
+    pub cancelled: bool,
+}
+
+/// Renders samples `samples` (a range of sample indices, e.g. `0..spp`) of every pixel.
+/// Works in passes of a few samples over the whole image; between work items it checks
+/// `cancel`, and after each item it reports the number of pixel samples done to
+/// `progress`. The result depends only on the scene, its seed and the range: not on the
+/// thread count or the order of work.
+pub fn render(
+    scene: &Scene,
+    samples: Range<u32>,
+    cancel: &AtomicBool,
+    progress: &(dyn Fn(u64) + Sync),
+) -> RenderResult {
+    let (w, h) = (scene.settings.width, scene.settings.height);
+    let mut film = Film::new(w, h);
+    let spp = samples.len() as u32;
+    let pass_spp = (spp / 16).clamp(1, 8);
+    let mut stats = RenderStats::default();
+    let sampler = IndependentSampler::new(scene.settings.seed);
+    let mut start = samples.start;
+    while start < samples.end && !cancel.load(Ordering::Relaxed) {
+        let pass = start..(start + pass_spp).min(samples.end);
+        let pass_stats = film
+            .pixels
+            .par_chunks_mut(w as usize * BAND_ROWS)
+            .enumerate()
+            .map(|(band, pixels)| {
+                if cancel.load(Ordering::Relaxed) {
+                    return RenderStats::default();
+                }
+                let mut sampler = sampler.clone();
+                let y0 = (band * BAND_ROWS) as u32;
+                let s = render_pixels(scene, &mut sampler, pixels, w, y0, pass.clone());
+                progress(pixels.len() as u64 * pass.len() as u64);
+                s
+            })
+            .reduce(RenderStats::default, RenderStats::add);
+        stats = stats.add(pass_stats);
+        start = pass.end;
+    }
+    let cancelled = film.pixels.iter().any(|p| p.samples < spp);
+    RenderResult {
+        film,
+        stats,
+        cancelled,
+    }
+}
+
+fn render_pixels<S: Sampler>(
+    scene: &Scene,
+    sampler: &mut S,
+    pixels: &mut [Pixel],
+    width: u32,
+    y0: u32,
+    pass: Range<u32>,
+) -> RenderStats {
+    let mut stats = RenderStats::default();
+    for (i, pixel) in pixels.iter_mut().enumerate() {
+        let p = UVec2::new(i as u32 % width, y0 + i as u32 / width);
+        for index in pass.clone() {
+            sampler.start_pixel_sample(p, index);
+            let film_pos = p.as_vec2() + sampler.get_pixel_2d();
+            let ray = scene.camera.generate_ray(film_pos);
+            let l = li(scene, ray, sampler, &mut stats.rays);
+            stats.paths += 1;
+            pixel.add(l, 1.0);
+        }
+    }
+    stats
+}
+
+/// MIS weight of a strategy with density `pdf_f` against one with density `pdf_g`.
+fn mis_weight(mode: MisMode, pdf_f: f32, pdf_g: f32) -> f32 {
+    match mode {
+        MisMode::Power => power_heuristic(pdf_f, pdf_g),
+        _ => balance_heuristic(pdf_f, pdf_g),
+    }
+}
+
+/// Radiance arriving along `ray`, estimated by one path.
+pub fn li<S: Sampler>(scene: &Scene, mut ray: Ray, sampler: &mut S, rays: &mut u64) -> Vec3 {
+    let mode = scene.settings.mis;
+    let mut l = Vec3::ZERO;
+    let mut beta = Vec3::ONE;
+    let mut depth = 0u32;
+    // Whether the path's last bounce was a delta lobe (or the path just left the camera):
+    // then no light sampling could have found what the ray hits, so it counts in full.
+    let mut specular = true;
+    let mut prev_ctx = ShadingCtx {
+        p: ray.o,
+        n: Vec3::ZERO,
+    };
+    let mut prev_bsdf_pdf = 0.0f32;
+
+    // Weight of emission found by BSDF sampling, against NEE having found it.
+    let emitter_weight = |specular: bool,
+                          prev_ctx: &ShadingCtx,
+                          prev_bsdf_pdf: f32,
+                          id: LightId,
+                          d: Vec3| match mode {
+        _ if specular => 1.0,
+        MisMode::BsdfOnly => 1.0,
+        MisMode::NeeOnly => 0.0,
+        MisMode::Balance | MisMode::Power => {
+            let light_pdf =
+                scene.light_sampler.pmf(prev_ctx, id) * scene.light(id).pdf_li(prev_ctx, d);
+            mis_weight(mode, prev_bsdf_pdf, light_pdf)
+        }
+    };
+
+    loop {
+        *rays += 1;
+        let Some(si) = scene.intersect(&ray, f32::INFINITY) else {
+            for &id in &scene.infinite_lights {
+                let le = scene.light(id).le(&ray);
+                if le != Vec3::ZERO {
+                    l += beta * le * emitter_weight(specular, &prev_ctx, prev_bsdf_pdf, id, ray.d);
+                }
+            }
+            break;
+        };
+        let wo = -ray.d;
+        if let Some(id) = si.light {
+            let le = scene.light(id).radiance(si.ng, wo);
+            if le != Vec3::ZERO {
+                l += beta * le * emitter_weight(specular, &prev_ctx, prev_bsdf_pdf, id, ray.d);
+            }
+        }
+        if depth == scene.settings.max_depth {
+            break;
+        }
+
+        let bsdf = scene.materials[si.material.0 as usize].bsdf(si.ns, si.ng, si.uv);
+        let ctx = ShadingCtx { p: si.p, n: si.ns };
+        let (u_light, u_point) = (sampler.get_1d(), sampler.get_2d());
+        if !bsdf.is_delta() {
+            l += beta * sample_direct(scene, &si, &ctx, &bsdf, wo, u_light, u_point, rays);
+        }
+
+        let (u_lobe, u_dir) = (sampler.get_1d(), sampler.get_2d());
+        let Some(bs) = bsdf.sample(wo, u_lobe, u_dir) else {
+            break;
+        };
+        beta *= bs.f * bsdf.abs_cos(bs.wi) / bs.pdf;
+        specular = bs.flags.is_delta();
+        prev_bsdf_pdf = bs.pdf;
+        prev_ctx = ctx;
+        ray = si.spawn_ray(bs.wi);
+        depth += 1;
+
+        let u_rr = sampler.get_1d();
+        if depth >= RR_MIN_DEPTH {
+            let q = (1.0 - max_component(beta)).max(0.0);
+            if u_rr < q {
+                break;
+            }
+            beta /= 1.0 - q;
+        }
+        if beta == Vec3::ZERO || !beta.is_finite() {
+            break;
+        }
+    }
+    l
+}
+
+/// Next event estimation: one light picked by the light sampler, one point on it, a
+/// shadow ray, and the MIS weight against BSDF sampling of the same direction.
+#[allow(clippy::too_many_arguments)]
+fn sample_direct(
+    scene: &Scene,
+    si: &SurfaceInteraction,
+    ctx: &ShadingCtx,
+    bsdf: &Bsdf,
+    wo: Vec3,
+    u_light: f32,
+    u_point: Vec2,
+    rays: &mut u64,
+) -> Vec3 {
+    let mode = scene.settings.mis;
+    let Some((id, pmf)) = scene.light_sampler.sample(ctx, u_light) else {
+        return Vec3::ZERO;
+    };
+    let light = scene.light(id);
+    // BSDF-only estimation still needs NEE for delta lights, which no ray can hit.
+    if mode == MisMode::BsdfOnly && !light.is_delta() {
+        return Vec3::ZERO;
+    }
+    let Some(ls) = light.sample_li(ctx, u_point) else {
+        return Vec3::ZERO;
+    };
+    let f = bsdf.f(wo, ls.wi) * bsdf.abs_cos(ls.wi);
+    if f == Vec3::ZERO {
+        return Vec3::ZERO;
+    }
+    *rays += 1;
+    let visible = if ls.distance.is_finite() {
+        scene.unoccluded(si.p, si.ng, ls.p_light, ls.n_light)
+    } else {
+        scene.escapes(si.p, si.ng, ls.wi)
+    };
+    if !visible {
+        return Vec3::ZERO;
+    }
+    let light_pdf = pmf * ls.pdf;
+    let weight = match mode {
+        _ if ls.is_delta => 1.0,
+        MisMode::NeeOnly => 1.0,
+        _ => mis_weight(mode, light_pdf, bsdf.pdf(wo, ls.wi)),
+    };
+    f * ls.radiance * weight / light_pdf
+}

@@ -1,0 +1,46 @@
+//! Candela's render-time core: sampling, geometry, the BVH, cameras, BSDFs, lights and
+//! light selection, the path tracer and the film. It does no file I/O: loaders produce a
+//! [`desc::SceneDesc`] and [`build::build`] turns it into a [`Scene`].
+//!
+//! ```
+//! use candela_core::desc::*;
+//! use glam::{Mat4, Vec3};
+//! use std::sync::atomic::AtomicBool;
+//!
+//! let mut desc = SceneDesc::default();
+//! desc.render = RenderSettings { width: 8, height: 8, spp: 4, ..Default::default() };
+//! desc.materials.push(MaterialDesc {
+//!     name: "white".into(),
+//!     bsdf: BsdfDesc::Diffuse { albedo: TextureDesc::Constant(Vec3::splat(0.8)) },
+//!     span: Span::code(),
+//! });
+//! desc.shapes.push(ShapeDesc {
+//!     geometry: GeometryDesc::Sphere { center: Vec3::ZERO, radius: 1.0 },
+//!     material: "white".into(),
+//!     emission: Some(Vec3::ONE),
+//!     transform: Mat4::IDENTITY,
+//!     flip_normals: false,
+//!     span: Span::code(),
+//! });
+//! let scene = candela_core::build::build(&desc).unwrap();
+//! let result = candela_core::integrator::render(&scene, 0..4, &AtomicBool::new(false), &|_| {});
+//! assert_eq!(result.film.resolve()[4 * 8 + 4], Vec3::ONE); // the centre pixel sees the sphere
+//! ```
+
+pub mod bsdf;
+pub mod build;
+pub mod bvh;
+pub mod camera;
+pub mod desc;
+pub mod film;
+pub mod geometry;
+pub mod integrator;
+pub mod light;
+pub mod light_sampler;
+pub mod material;
+pub mod math;
+pub mod sampler;
+pub mod sampling;
+pub mod scene;
+
+pub use scene::Scene;

@@ -1,0 +1,113 @@
+//! Lights, and the three questions every light answers at a shading point:
+//!
+//! - **sample** ([`Light::sample_li`]): a direction towards the light with the radiance
+//!   arriving along it and its density;
+//! - **pdf** ([`Light::pdf_li`]): the density with which `sample_li` would have picked a
+//!   given direction, for MIS when a BSDF-sampled ray finds the light;
+//! - **radiance** ([`Light::radiance`] when a ray hits an area light, [`Light::le`] when
+//!   a ray escapes to an infinite light).
+//!
+//! All densities are in solid angle at the shading point. Delta lights (points) report
+//! `pdf = 1` and `is_delta`, and are never hit by rays.
+
+mod point;
+mod sphere;
+mod triangle;
+
+pub use point::PointLight;
+pub use sphere::SphereLight;
+pub use triangle::TriangleLight;
+
+use glam::{Vec2, Vec3};
+
+use crate::geometry::Ray;
+
+/// Index of a light in [`crate::Scene::lights`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub struct LightId(pub u32);
+
+/// Where light is being gathered: a point and its shading normal (zero where there is no
+/// surface, e.g. in a medium).
+#[derive(Clone, Copy, Debug)]
+pub struct ShadingCtx {
+    pub p: Vec3,
+    pub n: Vec3,
+}
+
+/// A sampled direction towards a light.
+#[derive(Clone, Copy, Debug)]
+pub struct LightSample {
+    /// Radiance arriving at the shading point from the light along `-wi`.
+    pub radiance: Vec3,
+    /// Unit direction from the shading point towards the light.
+    pub wi: Vec3,
+    /// Distance to the sampled point on the light (∞ for infinite lights).
+    pub distance: f32,
+    /// Solid-angle density of `wi`; 1 for delta lights.
+    pub pdf: f32,
+    pub is_delta: bool,
+    /// The sampled point on the light and its normal (zero for points), for the shadow ray.
+    pub p_light: Vec3,
+    pub n_light: Vec3,
+}
+
+#[derive(Clone, Debug)]
+pub enum Light {
+    Point(PointLight),
+    Triangle(TriangleLight),
+    Sphere(SphereLight),
+}
+
+impl Light {
+    pub fn sample_li(&self, ctx: &ShadingCtx, u: Vec2) -> Option<LightSample> {
+        let s = match self {
+            Light::Point(l) => l.sample_li(ctx),
+            Light::Triangle(l) => l.sample_li(ctx, u),
+            Light::Sphere(l) => l.sample_li(ctx, u),
+        }?;
+        (s.pdf > 0.0 && s.pdf.is_finite() && s.radiance != Vec3::ZERO).then_some(s)
+    }
+
+    /// Density in solid angle with which [`Self::sample_li`] picks direction `wi` at `ctx`.
+    pub fn pdf_li(&self, ctx: &ShadingCtx, wi: Vec3) -> f32 {
+        match self {
+            Light::Point(_) => 0.0,
+            Light::Triangle(l) => l.pdf_li(ctx, wi),
+            Light::Sphere(l) => l.pdf_li(ctx, wi),
+        }
+    }
+
+    /// Radiance leaving an area light at a point with geometric normal `n` in direction `w`.
+    pub fn radiance(&self, n: Vec3, w: Vec3) -> Vec3 {
+        match self {
+            Light::Point(_) => Vec3::ZERO,
+            Light::Triangle(l) => l.radiance(n, w),
+            Light::Sphere(l) => l.radiance(n, w),
+        }
+    }
+
+    /// Radiance an infinite light sends along an escaped ray.
+    pub fn le(&self, _ray: &Ray) -> Vec3 {
+        match self {
+            Light::Point(_) | Light::Triangle(_) | Light::Sphere(_) => Vec3::ZERO,
+        }
+    }
+
+    /// Total emitted power Φ, as a luminance-weighted scalar (W).
+    pub fn power(&self) -> f32 {
+        match self {
+            Light::Point(l) => l.power(),
+            Light::Triangle(l) => l.power(),
+            Light::Sphere(l) => l.power(),
+        }
+    }
+
+    pub fn is_delta(&self) -> bool {
+        matches!(self, Light::Point(_))
+    }
+
+    /// Whether escaped rays see this light (environment lights).
+    pub fn is_infinite(&self) -> bool {
+        false
+    }
+}

@@ -1,0 +1,37 @@
+use std::f32::consts::PI;
+
+use glam::Vec3;
+
+use super::{LightSample, ShadingCtx};
+use crate::math::luminance;
+
+/// An isotropic point light: radiant intensity `intensity` (W/sr) in every direction.
+#[derive(Clone, Debug)]
+pub struct PointLight {
+    pub position: Vec3,
+    pub intensity: Vec3,
+}
+
+impl PointLight {
+    pub fn sample_li(&self, ctx: &ShadingCtx) -> Option<LightSample> {
+        let to = self.position - ctx.p;
+        let d2 = to.length_squared();
+        if d2 == 0.0 {
+            return None;
+        }
+        let distance = d2.sqrt();
+        Some(LightSample {
+            radiance: self.intensity / d2,
+            wi: to / distance,
+            distance,
+            pdf: 1.0,
+            is_delta: true,
+            p_light: self.position,
+            n_light: Vec3::ZERO,
+        })
+    }
+
+    pub fn power(&self) -> f32 {
+        4.0 * PI * luminance(self.intensity)
+    }
+}

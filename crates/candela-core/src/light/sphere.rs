@@ -1,0 +1,114 @@
+use std::f32::consts::PI;
+
+use glam::{Vec2, Vec3};
+
+use super::{LightSample, ShadingCtx};
+use crate::geometry::{intersect_sphere, Ray};
+use crate::math::{luminance, Frame};
+use crate::sampling::{sample_uniform_cone, sample_uniform_sphere, uniform_cone_pdf};
+
+/// An emitting sphere. With `inward = false` it emits `le` outwards and, seen from outside,
+/// is sampled uniformly within the cone it subtends (pbrt-v4 §6.2.4); otherwise (emitting
+/// inwards, or a shading point inside it) it is sampled uniformly by area.
+#[derive(Clone, Debug)]
+pub struct SphereLight {
+    pub center: Vec3,
+    pub radius: f32,
+    pub le: Vec3,
+    pub inward: bool,
+}
+
+impl SphereLight {
+    fn sees_outside(&self, p: Vec3) -> Option<f32> {
+        let d2 = (p - self.center).length_squared();
+        let r2 = self.radius * self.radius;
+        // cos θ_max of the subtended cone, if the point is clearly outside.
+        (!self.inward && d2 > r2 * 1.0001).then(|| (1.0 - r2 / d2).max(0.0).sqrt())
+    }
+
+    fn area(&self) -> f32 {
+        4.0 * PI * self.radius * self.radius
+    }
+
+    pub fn sample_li(&self, ctx: &ShadingCtx, u: Vec2) -> Option<LightSample> {
+        if let Some(cos_max) = self.sees_outside(ctx.p) {
+            let axis = (self.center - ctx.p).normalize();
+            let local = sample_uniform_cone(u, cos_max);
+            let wi = Frame::from_z(axis).to_world(local).normalize();
+            // The point where wi first meets the sphere; at the cone's rim, the tangent point.
+            let ray = Ray::new(ctx.p, wi);
+            let t = intersect_sphere(&ray, self.center, self.radius, f32::INFINITY)
+                .unwrap_or_else(|| (self.center - ctx.p).dot(wi));
+            let n = (ray.at(t) - self.center).normalize();
+            let p_light = self.center + n * self.radius;
+            return Some(LightSample {
+                radiance: self.le,
+                wi,
+                distance: t,
+                pdf: uniform_cone_pdf(cos_max),
+                is_delta: false,
+                p_light,
+                n_light: n,
+            });
+        }
+        let n_out = sample_uniform_sphere(u);
+        let p = self.center + n_out * self.radius;
+        let n = if self.inward { -n_out } else { n_out };
+        let to = p - ctx.p;
+        let d2 = to.length_squared();
+        if d2 == 0.0 {
+            return None;
+        }
+        let distance = d2.sqrt();
+        let wi = to / distance;
+        let cos_l = -wi.dot(n);
+        if cos_l <= 0.0 {
+            return None;
+        }
+        Some(LightSample {
+            radiance: self.le,
+            wi,
+            distance,
+            pdf: d2 / (cos_l * self.area()),
+            is_delta: false,
+            p_light: p,
+            n_light: n,
+        })
+    }
+
+    pub fn pdf_li(&self, ctx: &ShadingCtx, wi: Vec3) -> f32 {
+        if let Some(cos_max) = self.sees_outside(ctx.p) {
+            let axis = (self.center - ctx.p).normalize();
+            return if wi.dot(axis) >= cos_max {
+                uniform_cone_pdf(cos_max)
+            } else {
+                0.0
+            };
+        }
+        // Area sampling: the density of the first surface point along wi. A point inside
+        // sees exactly one point of the sphere in each direction.
+        let ray = Ray::new(ctx.p, wi);
+        let Some(t) = intersect_sphere(&ray, self.center, self.radius, f32::INFINITY) else {
+            return 0.0;
+        };
+        let n_out = (ray.at(t) - self.center) / self.radius;
+        let n = if self.inward { -n_out } else { n_out };
+        let cos_l = -wi.dot(n);
+        if cos_l <= 0.0 {
+            return 0.0;
+        }
+        t * t / (cos_l * self.area())
+    }
+
+    pub fn radiance(&self, n: Vec3, w: Vec3) -> Vec3 {
+        if n.dot(w) > 0.0 {
+            self.le
+        } else {
+            Vec3::ZERO
+        }
+    }
+
+    pub fn power(&self) -> f32 {
+        PI * self.area() * luminance(self.le)
+    }
+}

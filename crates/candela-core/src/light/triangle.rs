@@ -1,0 +1,77 @@
+use std::f32::consts::PI;
+
+use glam::{Vec2, Vec3};
+
+use super::{LightSample, ShadingCtx};
+use crate::geometry::{Ray, WatertightRay};
+use crate::math::luminance;
+use crate::sampling::sample_uniform_triangle;
+
+/// One emitting triangle of a mesh. Emits `le` on the side its normal `n` points to.
+/// Sampled uniformly by area; the density is converted to solid angle at the shading
+/// point, p_ω = d² / (|cos θ_l| · A).
+#[derive(Clone, Debug)]
+pub struct TriangleLight {
+    pub p: [Vec3; 3],
+    pub n: Vec3,
+    pub area: f32,
+    pub le: Vec3,
+}
+
+impl TriangleLight {
+    /// A light for a triangle with unit normal `n` (the emitting side).
+    pub fn new(p: [Vec3; 3], n: Vec3, le: Vec3) -> TriangleLight {
+        let area = 0.5 * (p[1] - p[0]).cross(p[2] - p[0]).length();
+        TriangleLight { p, n, area, le }
+    }
+
+    pub fn sample_li(&self, ctx: &ShadingCtx, u: Vec2) -> Option<LightSample> {
+        let b = sample_uniform_triangle(u);
+        let p = self.p[0] * b.x + self.p[1] * b.y + self.p[2] * b.z;
+        let to = p - ctx.p;
+        let d2 = to.length_squared();
+        if d2 == 0.0 || self.area == 0.0 {
+            return None;
+        }
+        let distance = d2.sqrt();
+        let wi = to / distance;
+        let cos_l = -wi.dot(self.n);
+        if cos_l <= 0.0 {
+            return None;
+        }
+        Some(LightSample {
+            radiance: self.le,
+            wi,
+            distance,
+            pdf: d2 / (cos_l * self.area),
+            is_delta: false,
+            p_light: p,
+            n_light: self.n,
+        })
+    }
+
+    pub fn pdf_li(&self, ctx: &ShadingCtx, wi: Vec3) -> f32 {
+        let cos_l = -wi.dot(self.n);
+        if cos_l <= 0.0 || self.area == 0.0 {
+            return 0.0;
+        }
+        let ray = Ray::new(ctx.p, wi);
+        match WatertightRay::new(&ray).intersect(self.p[0], self.p[1], self.p[2], f32::INFINITY) {
+            Some(hit) => hit.t * hit.t / (cos_l * self.area),
+            None => 0.0,
+        }
+    }
+
+    pub fn radiance(&self, n: Vec3, w: Vec3) -> Vec3 {
+        if n.dot(w) > 0.0 {
+            self.le
+        } else {
+            Vec3::ZERO
+        }
+    }
+
+    /// Φ = π · A · L for a one-sided Lambertian emitter.
+    pub fn power(&self) -> f32 {
+        PI * self.area * luminance(self.le)
+    }
+}

@@ -1,0 +1,114 @@
+//! Small numeric helpers shared by the whole core.
+
+use glam::Vec3;
+
+/// An orthonormal basis with `n` as its z axis: the local shading frame of the BSDFs.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Frame {
+    pub s: Vec3,
+    pub t: Vec3,
+    pub n: Vec3,
+}
+
+impl Frame {
+    /// A frame around the unit vector `n`, after Duff et al. 2017, "Building an
+    /// Orthonormal Basis, Revisited" (branchless, no singularity).
+    pub fn from_z(n: Vec3) -> Frame {
+        let sign = 1.0f32.copysign(n.z);
+        let a = -1.0 / (sign + n.z);
+        let b = n.x * n.y * a;
+        let s = Vec3::new(1.0 + sign * n.x * n.x * a, sign * b, -sign * n.x);
+        let t = Vec3::new(b, sign + n.y * n.y * a, -n.y);
+        Frame { s, t, n }
+    }
+
+    pub fn to_local(&self, v: Vec3) -> Vec3 {
+        Vec3::new(v.dot(self.s), v.dot(self.t), v.dot(self.n))
+    }
+
+    pub fn to_world(&self, v: Vec3) -> Vec3 {
+        self.s * v.x + self.t * v.y + self.n * v.z
+    }
+}
+
+/// Relative luminance of a linear Rec.709 colour (ITU-R BT.709 weights).
+pub fn luminance(c: Vec3) -> f32 {
+    0.2126 * c.x + 0.7152 * c.y + 0.0722 * c.z
+}
+
+/// Offsets a ray origin `p` off a surface with geometric normal `n`, towards the side of
+/// `n`, by an amount that scales with the magnitude of `p`'s coordinates. Wächter and
+/// Binder, "A Fast and Robust Method for Avoiding Self-Intersection", Ray Tracing Gems
+/// ch. 6: integer ulp steps far from the origin, a small float step near it.
+pub fn offset_ray_origin(p: Vec3, n: Vec3) -> Vec3 {
+    const ORIGIN: f32 = 1.0 / 32.0;
+    const FLOAT_SCALE: f32 = 1.0 / 65536.0;
+    const INT_SCALE: f32 = 256.0;
+    let offset = |p: f32, n: f32| -> f32 {
+        let of_i = (INT_SCALE * n) as i32;
+        let bits = p.to_bits() as i32;
+        let stepped = f32::from_bits((bits + if p < 0.0 { -of_i } else { of_i }) as u32);
+        if p.abs() < ORIGIN {
+            p + FLOAT_SCALE * n
+        } else {
+            stepped
+        }
+    };
+    Vec3::new(offset(p.x, n.x), offset(p.y, n.y), offset(p.z, n.z))
+}
+
+/// `n` flipped, if needed, to lie on the same side as `v`.
+pub fn face_forward(n: Vec3, v: Vec3) -> Vec3 {
+    if n.dot(v) < 0.0 {
+        -n
+    } else {
+        n
+    }
+}
+
+/// Whether every channel of a colour is zero.
+pub fn is_black(c: Vec3) -> bool {
+    c == Vec3::ZERO
+}
+
+/// Largest channel of a colour.
+pub fn max_component(c: Vec3) -> f32 {
+    c.x.max(c.y).max(c.z)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn frame_is_orthonormal_for_every_axis_sign() {
+        for n in [
+            Vec3::Z,
+            -Vec3::Z,
+            Vec3::X,
+            -Vec3::Y,
+            Vec3::new(0.3, -0.4, 0.866).normalize(),
+        ] {
+            let f = Frame::from_z(n);
+            assert!((f.s.length() - 1.0).abs() < 1e-5);
+            assert!((f.t.length() - 1.0).abs() < 1e-5);
+            assert!(
+                f.s.dot(f.t).abs() < 1e-5 && f.s.dot(n).abs() < 1e-5 && f.t.dot(n).abs() < 1e-5
+            );
+            assert!((f.s.cross(f.t) - n).length() < 1e-5, "right-handed");
+            let v = Vec3::new(0.2, 0.5, -0.7);
+            assert!((f.to_world(f.to_local(v)) - v).length() < 1e-5);
+        }
+    }
+
+    #[test]
+    fn offset_moves_to_the_normal_side_at_every_scale() {
+        for scale in [0.0f32, 1e-3, 1.0, 1e3, 1e5] {
+            let p = Vec3::new(scale, -scale, scale * 0.5);
+            let n = Vec3::new(0.0, 1.0, 0.0);
+            let q = offset_ray_origin(p, n);
+            assert!(q.y > p.y, "scale {scale}: {q:?}");
+            assert_eq!(q.x, p.x);
+        }
+    }
+}

@@ -1,0 +1,315 @@
+//! Sample warps from the unit square, with their densities, and discrete distributions.
+//!
+//! Every `sample_*` maps uniform `u ∈ [0,1)²` to a point of its domain; the matching
+//! `*_pdf` gives the density of that warp with respect to the domain's natural measure
+//! (solid angle for directions, area for points). Each warp is checked by the chi-square
+//! suite in `tests/chi2_warps.rs`.
+
+use std::f32::consts::{FRAC_PI_2, FRAC_PI_4, PI};
+
+use glam::{Vec2, Vec3};
+
+/// Shirley–Chiu concentric map from the square to the unit disk (area-preserving up to
+/// the factor π).
+pub fn sample_concentric_disk(u: Vec2) -> Vec2 {
+    let o = 2.0 * u - Vec2::ONE;
+    if o == Vec2::ZERO {
+        return Vec2::ZERO;
+    }
+    let (r, theta) = if o.x.abs() > o.y.abs() {
+        (o.x, FRAC_PI_4 * (o.y / o.x))
+    } else {
+        (o.y, FRAC_PI_2 - FRAC_PI_4 * (o.x / o.y))
+    };
+    r * Vec2::new(theta.cos(), theta.sin())
+}
+
+/// Cosine-weighted direction on the hemisphere around +z (Malley's method).
+pub fn sample_cosine_hemisphere(u: Vec2) -> Vec3 {
+    let d = sample_concentric_disk(u);
+    let z = (1.0 - d.length_squared()).max(0.0).sqrt();
+    Vec3::new(d.x, d.y, z)
+}
+
+/// Density of [`sample_cosine_hemisphere`] in solid angle.
+pub fn cosine_hemisphere_pdf(cos_theta: f32) -> f32 {
+    cos_theta.max(0.0) / PI
+}
+
+/// Uniform direction on the unit sphere.
+pub fn sample_uniform_sphere(u: Vec2) -> Vec3 {
+    let z = 1.0 - 2.0 * u.x;
+    let r = (1.0 - z * z).max(0.0).sqrt();
+    let phi = 2.0 * PI * u.y;
+    Vec3::new(r * phi.cos(), r * phi.sin(), z)
+}
+
+/// Density of [`sample_uniform_sphere`] in solid angle.
+pub const UNIFORM_SPHERE_PDF: f32 = 1.0 / (4.0 * PI);
+
+/// Uniform direction in the cone around +z with half-angle `acos(cos_max)`.
+pub fn sample_uniform_cone(u: Vec2, cos_max: f32) -> Vec3 {
+    let cos_theta = (1.0 - u.x) + u.x * cos_max;
+    let sin_theta = (1.0 - cos_theta * cos_theta).max(0.0).sqrt();
+    let phi = 2.0 * PI * u.y;
+    Vec3::new(sin_theta * phi.cos(), sin_theta * phi.sin(), cos_theta)
+}
+
+/// Density of [`sample_uniform_cone`] in solid angle.
+pub fn uniform_cone_pdf(cos_max: f32) -> f32 {
+    1.0 / (2.0 * PI * (1.0 - cos_max))
+}
+
+/// Uniform barycentric coordinates `(b0, b1, b2)` on a triangle (Heitz 2019, "A Low-
+/// Distortion Map Between Triangle and Square").
+pub fn sample_uniform_triangle(u: Vec2) -> Vec3 {
+    let (b0, b1) = if u.x < u.y {
+        let b0 = u.x / 2.0;
+        (b0, u.y - b0)
+    } else {
+        let b1 = u.y / 2.0;
+        (u.x - b1, b1)
+    };
+    Vec3::new(b0, b1, 1.0 - b0 - b1)
+}
+
+/// Balance heuristic weight of strategy `f` against strategy `g` (one sample each).
+pub fn balance_heuristic(pdf_f: f32, pdf_g: f32) -> f32 {
+    if pdf_f == 0.0 {
+        return 0.0;
+    }
+    pdf_f / (pdf_f + pdf_g)
+}
+
+/// Power heuristic (β = 2) weight of strategy `f` against strategy `g`.
+pub fn power_heuristic(pdf_f: f32, pdf_g: f32) -> f32 {
+    if pdf_f == 0.0 {
+        return 0.0;
+    }
+    let (f, g) = (pdf_f * pdf_f, pdf_g * pdf_g);
+    if f.is_infinite() {
+        return 1.0;
+    }
+    f / (f + g)
+}
+
+/// Walker's alias method, built with Vose's stable algorithm: O(n) build, O(1) sample.
+#[derive(Clone, Debug, Default)]
+pub struct AliasTable {
+    bins: Vec<AliasBin>,
+    total: f64,
+}
+
+#[derive(Clone, Copy, Debug)]
+struct AliasBin {
+    /// Probability of keeping this bin's own index.
+    q: f32,
+    alias: u32,
+    /// Normalized probability of this index.
+    pmf: f32,
+}
+
+impl AliasTable {
+    /// A table over non-negative `weights`. Returns `None` if no weight is positive or any
+    /// is negative or not finite.
+    pub fn new(weights: &[f32]) -> Option<AliasTable> {
+        if weights.iter().any(|w| !w.is_finite() || *w < 0.0) {
+            return None;
+        }
+        let total: f64 = weights.iter().map(|&w| w as f64).sum();
+        if total <= 0.0 {
+            return None;
+        }
+        let n = weights.len();
+        let mut bins: Vec<AliasBin> = weights
+            .iter()
+            .map(|&w| AliasBin {
+                q: 0.0,
+                alias: 0,
+                pmf: (w as f64 / total) as f32,
+            })
+            .collect();
+        // Scaled probabilities p·n: below 1 the bin is under-full and takes an alias.
+        let mut scaled: Vec<f64> = weights
+            .iter()
+            .map(|&w| w as f64 / total * n as f64)
+            .collect();
+        let (mut small, mut large): (Vec<usize>, Vec<usize>) =
+            (0..n).partition(|&i| scaled[i] < 1.0);
+        while let (Some(s), Some(&l)) = (small.pop(), large.last()) {
+            bins[s].q = scaled[s] as f32;
+            bins[s].alias = l as u32;
+            scaled[l] -= 1.0 - scaled[s];
+            if scaled[l] < 1.0 {
+                large.pop();
+                small.push(l);
+            }
+        }
+        // What remains is full up to round-off.
+        for i in small.into_iter().chain(large) {
+            bins[i].q = 1.0;
+            bins[i].alias = i as u32;
+        }
+        Some(AliasTable { bins, total })
+    }
+
+    pub fn len(&self) -> usize {
+        self.bins.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.bins.is_empty()
+    }
+
+    /// Sum of the weights the table was built from.
+    pub fn total(&self) -> f64 {
+        self.total
+    }
+
+    /// Probability of index `i`.
+    pub fn pmf(&self, i: usize) -> f32 {
+        self.bins[i].pmf
+    }
+
+    /// An index with probability `pmf(index)`, from one uniform number.
+    pub fn sample(&self, u: f32) -> (usize, f32) {
+        let n = self.bins.len();
+        let scaled = u * n as f32;
+        let i = (scaled as usize).min(n - 1);
+        let up = (scaled - i as f32).min(ONE_MINUS_EPSILON);
+        let bin = &self.bins[i];
+        let index = if up < bin.q { i } else { bin.alias as usize };
+        (index, self.bins[index].pmf)
+    }
+}
+
+/// The largest float below one, so that `u < 1` is kept after scaling.
+pub const ONE_MINUS_EPSILON: f32 = 1.0 - f32::EPSILON / 2.0;
+
+/// A piecewise-constant density on [0, 1) with `n` equal cells, sampled by inverting its
+/// CDF with a binary search.
+#[derive(Clone, Debug)]
+pub struct Distribution1D {
+    func: Vec<f32>,
+    cdf: Vec<f32>,
+    integral: f32,
+}
+
+impl Distribution1D {
+    /// A distribution proportional to `func` (non-negative). Where all values are zero the
+    /// distribution is uniform, so that it can still be sampled.
+    pub fn new(func: &[f32]) -> Distribution1D {
+        assert!(!func.is_empty(), "Distribution1D needs at least one cell");
+        let n = func.len();
+        let mut cdf = Vec::with_capacity(n + 1);
+        cdf.push(0.0f32);
+        let mut acc = 0.0f64;
+        for &f in func {
+            acc += f.max(0.0) as f64 / n as f64;
+            cdf.push(acc as f32);
+        }
+        let integral = acc as f32;
+        let func: Vec<f32> = if integral > 0.0 {
+            for c in cdf.iter_mut() {
+                *c /= integral;
+            }
+            func.iter().map(|f| f.max(0.0)).collect()
+        } else {
+            for (i, c) in cdf.iter_mut().enumerate() {
+                *c = i as f32 / n as f32;
+            }
+            vec![1.0; n]
+        };
+        let integral = if integral > 0.0 { integral } else { 1.0 };
+        Distribution1D {
+            func,
+            cdf,
+            integral,
+        }
+    }
+
+    pub fn len(&self) -> usize {
+        self.func.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.func.is_empty()
+    }
+
+    /// The integral of the function over [0, 1).
+    pub fn integral(&self) -> f32 {
+        self.integral
+    }
+
+    /// Samples a continuous x ∈ [0,1); returns (x, density at x, cell index).
+    pub fn sample_continuous(&self, u: f32) -> (f32, f32, usize) {
+        let n = self.func.len();
+        // Last cell whose CDF start is <= u.
+        let i = self
+            .cdf
+            .partition_point(|&c| c <= u)
+            .saturating_sub(1)
+            .min(n - 1);
+        let width = self.cdf[i + 1] - self.cdf[i];
+        let du = if width > 0.0 {
+            ((u - self.cdf[i]) / width).clamp(0.0, ONE_MINUS_EPSILON)
+        } else {
+            0.0
+        };
+        let pdf = self.func[i] / self.integral;
+        (((i as f32 + du) / n as f32).min(ONE_MINUS_EPSILON), pdf, i)
+    }
+
+    /// Density at `x ∈ [0,1)` of [`Self::sample_continuous`].
+    pub fn pdf(&self, x: f32) -> f32 {
+        let n = self.func.len();
+        let i = ((x * n as f32) as usize).min(n - 1);
+        self.func[i] / self.integral
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn alias_table_pmf_matches_weights_and_sums_to_one() {
+        let w = [1.0, 0.0, 3.0, 0.5, 10.0];
+        let t = AliasTable::new(&w).unwrap();
+        let total: f32 = w.iter().sum();
+        let sum: f32 = (0..w.len()).map(|i| t.pmf(i)).sum();
+        assert!((sum - 1.0).abs() < 1e-6);
+        for (i, wi) in w.iter().enumerate() {
+            assert!((t.pmf(i) - wi / total).abs() < 1e-6);
+        }
+        // A zero-weight entry is never returned, whatever u is.
+        for k in 0..10_000 {
+            let (i, _) = t.sample(k as f32 / 10_000.0);
+            assert_ne!(i, 1);
+        }
+    }
+
+    #[test]
+    fn alias_table_rejects_degenerate_weights() {
+        assert!(AliasTable::new(&[]).is_none());
+        assert!(AliasTable::new(&[0.0, 0.0]).is_none());
+        assert!(AliasTable::new(&[1.0, f32::NAN]).is_none());
+        assert!(AliasTable::new(&[1.0, -1.0]).is_none());
+    }
+
+    #[test]
+    fn distribution_1d_inverts_its_cdf() {
+        let d = Distribution1D::new(&[0.0, 1.0, 3.0, 0.0]);
+        assert!((d.integral() - 1.0).abs() < 1e-6);
+        let (x, pdf, i) = d.sample_continuous(0.5);
+        assert_eq!(i, 2);
+        assert!((pdf - 3.0).abs() < 1e-5);
+        assert!((0.5..0.75).contains(&x));
+        assert_eq!(d.pdf(0.1), 0.0);
+        // Zero cells are never sampled, even at the CDF's flat ends.
+        for u in [0.0, 1e-7, 0.25, 0.9999999] {
+            let (_, pdf, _) = d.sample_continuous(u);
+            assert!(pdf > 0.0, "u = {u}");
+        }
+    }
+}

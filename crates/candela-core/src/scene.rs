@@ -1,0 +1,269 @@
+//! The render-time scene: flat arrays addressed by small ids, a BVH over all primitives,
+//! and the queries the integrator asks of them.
+
+use glam::{Vec2, Vec3};
+
+use crate::bvh::Bvh;
+use crate::camera::Camera;
+use crate::desc::RenderSettings;
+use crate::geometry::{intersect_sphere, Aabb, Ray, WatertightRay};
+use crate::light::{Light, LightId};
+use crate::light_sampler::LightSampler;
+use crate::material::{Material, MaterialId};
+use crate::math::offset_ray_origin;
+
+/// A triangle mesh in world space.
+#[derive(Clone, Debug)]
+pub struct Mesh {
+    pub positions: Vec<Vec3>,
+    /// Empty, or one unit normal per position.
+    pub normals: Vec<Vec3>,
+    /// Empty, or one per position.
+    pub uvs: Vec<Vec2>,
+    pub indices: Vec<[u32; 3]>,
+    pub material: MaterialId,
+    /// Light of each triangle, if the mesh emits (same length as `indices`).
+    pub lights: Vec<LightId>,
+    /// Geometric normals point away from the winding's front side when set.
+    pub flip_normals: bool,
+}
+
+impl Mesh {
+    pub fn vertices(&self, tri: u32) -> [Vec3; 3] {
+        let [a, b, c] = self.indices[tri as usize];
+        [
+            self.positions[a as usize],
+            self.positions[b as usize],
+            self.positions[c as usize],
+        ]
+    }
+
+    /// Unit geometric normal of a triangle: from the winding, turned towards the shading
+    /// normals where the mesh has them, and flipped by `flip_normals`. Zero for a
+    /// degenerate triangle.
+    pub fn geometric_normal(&self, tri: u32) -> Vec3 {
+        let [p0, p1, p2] = self.vertices(tri);
+        let mut n = (p1 - p0).cross(p2 - p0).normalize_or_zero();
+        if !self.normals.is_empty() {
+            let [a, b, c] = self.indices[tri as usize];
+            let ns = self.normals[a as usize] + self.normals[b as usize] + self.normals[c as usize];
+            if n.dot(ns) < 0.0 {
+                n = -n;
+            }
+        }
+        if self.flip_normals {
+            -n
+        } else {
+            n
+        }
+    }
+}
+
+#[derive(Clone, Debug)]
+pub struct Sphere {
+    pub center: Vec3,
+    pub radius: f32,
+    pub material: MaterialId,
+    pub light: Option<LightId>,
+    /// Normals point inwards.
+    pub flip_normals: bool,
+}
+
+/// A primitive in the BVH.
+#[derive(Clone, Copy, Debug)]
+pub enum Prim {
+    Triangle { mesh: u32, tri: u32 },
+    Sphere(u32),
+}
+
+/// What a ray found.
+#[derive(Clone, Copy, Debug)]
+pub struct SurfaceInteraction {
+    pub p: Vec3,
+    pub t: f32,
+    /// Unit geometric normal (see [`Mesh::geometric_normal`]).
+    pub ng: Vec3,
+    /// Unit shading normal, on the same side as `ng`.
+    pub ns: Vec3,
+    pub uv: Vec2,
+    pub material: MaterialId,
+    pub light: Option<LightId>,
+}
+
+impl SurfaceInteraction {
+    /// A ray leaving this surface towards `d`, its origin moved off the surface.
+    pub fn spawn_ray(&self, d: Vec3) -> Ray {
+        let n = if d.dot(self.ng) >= 0.0 {
+            self.ng
+        } else {
+            -self.ng
+        };
+        Ray::new(offset_ray_origin(self.p, n), d)
+    }
+}
+
+/// The scene as the integrator sees it. Made by [`crate::build::build`].
+#[derive(Clone, Debug)]
+pub struct Scene {
+    pub camera: Camera,
+    pub settings: RenderSettings,
+    pub meshes: Vec<Mesh>,
+    pub spheres: Vec<Sphere>,
+    pub materials: Vec<Material>,
+    pub lights: Vec<Light>,
+    /// Lights that escaped rays see.
+    pub infinite_lights: Vec<LightId>,
+    pub light_sampler: LightSampler,
+    pub prims: Vec<Prim>,
+    pub bvh: Bvh,
+}
+
+impl Scene {
+    pub fn bounds(&self) -> Aabb {
+        self.bvh.bounds()
+    }
+
+    pub fn triangle_count(&self) -> usize {
+        self.meshes.iter().map(|m| m.indices.len()).sum()
+    }
+
+    pub fn light(&self, id: LightId) -> &Light {
+        &self.lights[id.0 as usize]
+    }
+
+    /// The nearest surface along the ray within (0, t_max).
+    pub fn intersect(&self, ray: &Ray, t_max: f32) -> Option<SurfaceInteraction> {
+        let wray = WatertightRay::new(ray);
+        let mut bary = Vec2::ZERO;
+        let (prim, t) =
+            self.bvh
+                .intersect(ray, t_max, |i, t_max| match self.prims[i as usize] {
+                    Prim::Triangle { mesh, tri } => {
+                        let [p0, p1, p2] = self.meshes[mesh as usize].vertices(tri);
+                        let hit = wray.intersect(p0, p1, p2, t_max)?;
+                        bary = Vec2::new(hit.b1, hit.b2);
+                        Some(hit.t)
+                    }
+                    Prim::Sphere(s) => {
+                        let s = &self.spheres[s as usize];
+                        intersect_sphere(ray, s.center, s.radius, t_max)
+                    }
+                })?;
+        // Barycentrics belong to the last primitive that narrowed the search: the nearest.
+        Some(self.interaction(ray, self.prims[prim as usize], t, bary))
+    }
+
+    /// Whether anything lies on the ray within (0, t_max).
+    pub fn occluded(&self, ray: &Ray, t_max: f32) -> bool {
+        let wray = WatertightRay::new(ray);
+        self.bvh
+            .occluded(ray, t_max, |i, t_max| match self.prims[i as usize] {
+                Prim::Triangle { mesh, tri } => {
+                    let [p0, p1, p2] = self.meshes[mesh as usize].vertices(tri);
+                    wray.intersect(p0, p1, p2, t_max).is_some()
+                }
+                Prim::Sphere(s) => {
+                    let s = &self.spheres[s as usize];
+                    intersect_sphere(ray, s.center, s.radius, t_max).is_some()
+                }
+            })
+    }
+
+    /// Whether the segment from surface point `from` (normal `n_from`) to point `to`
+    /// (normal `n_to`, zero for a point light) is unblocked. Both ends are moved off their
+    /// surfaces so that neither surface blocks its own ray.
+    pub fn unoccluded(&self, from: Vec3, n_from: Vec3, to: Vec3, n_to: Vec3) -> bool {
+        let d = to - from;
+        let o = offset_ray_origin(
+            from,
+            if d.dot(n_from) >= 0.0 {
+                n_from
+            } else {
+                -n_from
+            },
+        );
+        let target = if n_to == Vec3::ZERO {
+            to
+        } else {
+            offset_ray_origin(to, if d.dot(n_to) <= 0.0 { n_to } else { -n_to })
+        };
+        let d = target - o;
+        let dist = d.length();
+        if dist == 0.0 || !dist.is_finite() {
+            return dist == 0.0;
+        }
+        // A relative margin keeps the far end from blocking itself.
+        !self.occluded(&Ray::new(o, d / dist), dist * (1.0 - 1e-4))
+    }
+
+    /// Whether a ray leaving `from` towards `d` escapes the scene.
+    pub fn escapes(&self, from: Vec3, n_from: Vec3, d: Vec3) -> bool {
+        let o = offset_ray_origin(
+            from,
+            if d.dot(n_from) >= 0.0 {
+                n_from
+            } else {
+                -n_from
+            },
+        );
+        !self.occluded(&Ray::new(o, d), f32::INFINITY)
+    }
+
+    fn interaction(&self, ray: &Ray, prim: Prim, t: f32, bary: Vec2) -> SurfaceInteraction {
+        match prim {
+            Prim::Triangle { mesh, tri } => {
+                let m = &self.meshes[mesh as usize];
+                let [p0, p1, p2] = m.vertices(tri);
+                let b0 = 1.0 - bary.x - bary.y;
+                // Barycentric interpolation is more accurate than o + t·d.
+                let p = p0 * b0 + p1 * bary.x + p2 * bary.y;
+                let ng = m.geometric_normal(tri);
+                let [a, b, c] = m.indices[tri as usize].map(|i| i as usize);
+                let mut ns = ng;
+                if !m.normals.is_empty() {
+                    let n = (m.normals[a] * b0 + m.normals[b] * bary.x + m.normals[c] * bary.y)
+                        .normalize_or_zero();
+                    if n != Vec3::ZERO {
+                        ns = if m.flip_normals { -n } else { n };
+                    }
+                }
+                let uv = if m.uvs.is_empty() {
+                    Vec2::new(bary.x, bary.y)
+                } else {
+                    m.uvs[a] * b0 + m.uvs[b] * bary.x + m.uvs[c] * bary.y
+                };
+                let light = m.lights.get(tri as usize).copied();
+                SurfaceInteraction {
+                    p,
+                    t,
+                    ng,
+                    ns,
+                    uv,
+                    material: m.material,
+                    light,
+                }
+            }
+            Prim::Sphere(i) => {
+                let s = &self.spheres[i as usize];
+                let n_out = (ray.at(t) - s.center).normalize();
+                // Project back onto the surface to remove the error of o + t·d.
+                let p = s.center + n_out * s.radius;
+                let n = if s.flip_normals { -n_out } else { n_out };
+                let phi = n_out.z.atan2(n_out.x);
+                let uv = Vec2::new(
+                    (phi / std::f32::consts::TAU).rem_euclid(1.0),
+                    n_out.y.clamp(-1.0, 1.0).acos() / std::f32::consts::PI,
+                );
+                SurfaceInteraction {
+                    p,
+                    t,
+                    ng: n,
+                    ns: n,
+                    uv,
+                    material: s.material,
+                    light: s.light,
+                }
+            }
+        }
+    }
+}
