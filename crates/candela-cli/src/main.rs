@@ -1,1 +1,74 @@
-fn main() {}
+//! `candela`: render scenes from the command line.
+//!
+//! Exit codes: 0 success, 2 bad input or a failed write (one line on stderr naming the
+//! file and what is wrong), 130 interrupted (the partial image is still written), 101 an
+//! internal bug.
+
+mod info;
+mod output;
+mod render;
+
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+use clap::{Parser, Subcommand, ValueEnum};
+
+#[derive(Parser)]
+#[command(name = "candela", version, about = "A physically based path tracer")]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Render a scene to an image (.exr and .pfm linear, .png sRGB).
+    Render(render::RenderArgs),
+    /// Print what a scene contains: shapes, triangles, lights, materials, camera, bounds.
+    Info {
+        /// Scene file (.toml).
+        scene: PathBuf,
+    },
+}
+
+/// How a render is weighed between light sampling and BSDF sampling.
+#[derive(Clone, Copy, Debug, ValueEnum)]
+pub enum MisArg {
+    Balance,
+    Power,
+    /// Next event estimation only for direct light.
+    None,
+    /// BSDF sampling only (for testing).
+    Bsdf,
+}
+
+/// A user-facing failure: printed as one line, exit code 2.
+#[derive(Debug)]
+pub struct UserError(pub String);
+
+impl<E: std::fmt::Display> From<E> for UserError {
+    fn from(e: E) -> Self {
+        UserError(e.to_string())
+    }
+}
+
+fn main() -> ExitCode {
+    std::panic::set_hook(Box::new(|info| {
+        eprintln!("candela: internal error: {info}");
+        eprintln!(
+            "candela: this is a bug in Candela; please report it with the scene that caused it"
+        );
+    }));
+    let cli = Cli::parse();
+    let result = match cli.command {
+        Command::Render(args) => render::run(args),
+        Command::Info { scene } => info::run(&scene).map(|()| ExitCode::SUCCESS),
+    };
+    match result {
+        Ok(code) => code,
+        Err(UserError(message)) => {
+            eprintln!("candela: {message}");
+            ExitCode::from(2)
+        }
+    }
+}

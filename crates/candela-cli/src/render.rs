@@ -1,0 +1,177 @@
+//! `candela render`: load, build, render in parallel with a progress bar, write.
+//!
+//! Ctrl-C (or SIGTERM) stops the render at the next work item and writes the image
+//! accumulated so far, each pixel divided by its own sample count; a second Ctrl-C exits
+//! at once.
+
+use std::path::PathBuf;
+use std::process::ExitCode;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::Instant;
+
+use candela_core::desc::{LightSamplerKind, MisMode, SceneDesc};
+use candela_core::integrator;
+use clap::{Args, ValueEnum};
+use indicatif::{ProgressBar, ProgressStyle};
+
+use crate::output::{write_image, ImageFormat, LinearImage};
+use crate::{MisArg, UserError};
+
+#[derive(Args)]
+pub struct RenderArgs {
+    /// Scene file (.toml).
+    scene: PathBuf,
+    /// Output image: .exr, .pfm (linear) or .png (sRGB).
+    #[arg(short, long)]
+    output: PathBuf,
+    /// Samples per pixel.
+    #[arg(long)]
+    spp: Option<u32>,
+    /// Seed of the sample streams; the same seed gives the same image.
+    #[arg(long)]
+    seed: Option<u64>,
+    /// Worker threads (default: all cores).
+    #[arg(long)]
+    threads: Option<usize>,
+    /// Maximum scattering events per path (0: emitters only, 1: direct light).
+    #[arg(long)]
+    max_depth: Option<u32>,
+    /// Resolution as WIDTHxHEIGHT.
+    #[arg(long, value_parser = parse_resolution)]
+    res: Option<(u32, u32)>,
+    /// Exposure in stops, applied before PNG encoding.
+    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
+    exposure: f32,
+    /// MIS heuristic between light and BSDF sampling.
+    #[arg(long, value_enum)]
+    mis: Option<MisArg>,
+    /// How next event estimation picks a light.
+    #[arg(long, value_enum)]
+    light_sampler: Option<LightSamplerArg>,
+}
+
+#[derive(Clone, Copy, Debug, ValueEnum)]
+pub enum LightSamplerArg {
+    Uniform,
+    Power,
+}
+
+fn parse_resolution(s: &str) -> Result<(u32, u32), String> {
+    let (w, h) = s
+        .split_once(['x', 'X'])
+        .ok_or_else(|| format!("expected WIDTHxHEIGHT, got \"{s}\""))?;
+    let parse = |v: &str| v.trim().parse::<u32>().ok().filter(|&v| v > 0);
+    match (parse(w), parse(h)) {
+        (Some(w), Some(h)) => Ok((w, h)),
+        _ => Err(format!(
+            "expected WIDTHxHEIGHT with positive integers, got \"{s}\""
+        )),
+    }
+}
+
+impl RenderArgs {
+    fn apply_overrides(&self, desc: &mut SceneDesc) {
+        let r = &mut desc.render;
+        if let Some(spp) = self.spp {
+            r.spp = spp;
+        }
+        if let Some(seed) = self.seed {
+            r.seed = seed;
+        }
+        if let Some(d) = self.max_depth {
+            r.max_depth = d;
+        }
+        if let Some((w, h)) = self.res {
+            (r.width, r.height) = (w, h);
+        }
+        if let Some(m) = self.mis {
+            r.mis = match m {
+                MisArg::Balance => MisMode::Balance,
+                MisArg::Power => MisMode::Power,
+                MisArg::None => MisMode::NeeOnly,
+                MisArg::Bsdf => MisMode::BsdfOnly,
+            };
+        }
+        if let Some(l) = self.light_sampler {
+            r.light_sampler = match l {
+                LightSamplerArg::Uniform => LightSamplerKind::Uniform,
+                LightSamplerArg::Power => LightSamplerKind::Power,
+            };
+        }
+    }
+}
+
+static CANCEL: AtomicBool = AtomicBool::new(false);
+
+fn install_interrupt_handler() {
+    // A second interrupt while the first is being honoured exits at once.
+    let _ = ctrlc::set_handler(|| {
+        if CANCEL.swap(true, Ordering::SeqCst) {
+            eprintln!("\ncandela: interrupted again, exiting without writing");
+            std::process::exit(130);
+        }
+    });
+}
+
+pub fn run(args: RenderArgs) -> Result<ExitCode, UserError> {
+    // Fail on a bad output name before spending any time rendering.
+    ImageFormat::from_path(&args.output)?;
+    let mut desc = candela_scene::load_scene(&args.scene)?;
+    args.apply_overrides(&mut desc);
+    let scene = candela_core::build::build(&desc)?;
+    let s = &scene.settings;
+
+    let threads = args.threads.unwrap_or(0);
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .map_err(|e| UserError(format!("cannot start {threads} threads: {e}")))?;
+    install_interrupt_handler();
+
+    let total = s.width as u64 * s.height as u64 * s.spp as u64;
+    let bar = ProgressBar::new(total);
+    bar.set_style(
+        ProgressStyle::with_template(
+            "{spinner} [{elapsed_precise}] {wide_bar} {percent:>3}% ETA {eta}",
+        )
+        .expect("valid progress template"),
+    );
+    let start = Instant::now();
+    let result = pool.install(|| integrator::render(&scene, 0..s.spp, &CANCEL, &|n| bar.inc(n)));
+    let elapsed = start.elapsed().as_secs_f64();
+    bar.finish_and_clear();
+
+    let pixels = result.film.resolve();
+    let image = LinearImage {
+        width: s.width,
+        height: s.height,
+        pixels: &pixels,
+    };
+    write_image(&args.output, &image, args.exposure)?;
+
+    let st = result.stats;
+    println!(
+        "{}x{}, {} spp, {:.2} s, {:.2} M paths/s, {:.2} M rays/s -> {}",
+        s.width,
+        s.height,
+        s.spp,
+        elapsed,
+        st.paths as f64 / elapsed / 1e6,
+        st.rays as f64 / elapsed / 1e6,
+        args.output.display()
+    );
+    let rejected = result.film.rejected_samples();
+    if rejected > 0 {
+        println!("{rejected} non-finite samples were dropped");
+    }
+    if result.cancelled {
+        let done = result.film.total_samples() as f64 / total as f64;
+        eprintln!(
+            "candela: interrupted: wrote the partial image ({:.1}% of samples) to {}",
+            100.0 * done,
+            args.output.display()
+        );
+        return Ok(ExitCode::from(130));
+    }
+    Ok(ExitCode::SUCCESS)
+}
