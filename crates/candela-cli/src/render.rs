@@ -48,12 +48,19 @@ pub struct RenderArgs {
     /// How next event estimation picks a light.
     #[arg(long, value_enum)]
     light_sampler: Option<LightSamplerArg>,
+    /// Candidates per pick of the `ris` and `ris-bvh` light samplers.
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..))]
+    ris_candidates: Option<u32>,
 }
 
 #[derive(Clone, Copy, Debug, ValueEnum)]
 pub enum LightSamplerArg {
     Uniform,
     Power,
+    Array,
+    Ris,
+    Bvh,
+    RisBvh,
 }
 
 fn parse_resolution(s: &str) -> Result<(u32, u32), String> {
@@ -96,7 +103,14 @@ impl RenderArgs {
             r.light_sampler = match l {
                 LightSamplerArg::Uniform => LightSamplerKind::Uniform,
                 LightSamplerArg::Power => LightSamplerKind::Power,
+                LightSamplerArg::Array => LightSamplerKind::Array,
+                LightSamplerArg::Ris => LightSamplerKind::Ris,
+                LightSamplerArg::Bvh => LightSamplerKind::Bvh,
+                LightSamplerArg::RisBvh => LightSamplerKind::RisBvh,
             };
+        }
+        if let Some(n) = self.ris_candidates {
+            r.ris_candidates = n;
         }
     }
 }
