@@ -98,10 +98,12 @@ impl LightBvh {
                     index: 0,
                     is_leaf: false,
                 });
+                // Move the depth marker one bit up; the bit it leaves is the branch.
                 let depth = 63 - trail.leading_zeros();
-                self.flatten(*a, trail | (1 << (depth + 1)));
+                let child = (trail & !(1 << depth)) | (1 << (depth + 1));
+                self.flatten(*a, child);
                 self.nodes[at].index = self.nodes.len() as u32;
-                self.flatten(*b, trail | (1 << (depth + 1)) | (1 << depth));
+                self.flatten(*b, child | (1 << depth));
             }
         }
     }

@@ -1,0 +1,245 @@
+//! Light selection: every sampler's pmf sums to one and matches the frequencies of its
+//! picks (chi-square), and RIS's weight is unbiased per light (z-tests).
+//!
+//! The chi-square here is a compact local one (`candela_core::chi2` had not landed when
+//! this was written): bins with expected count < 5 are pooled, and the critical value
+//! comes from the Wilson–Hilferty approximation of the χ² quantile, accurate to ~1% for
+//! the 20+ degrees of freedom used here.
+
+use candela_core::desc::LightSamplerKind;
+use candela_core::light::{Light, LightId, PointLight, ShadingCtx, SphereLight, TriangleLight};
+use candela_core::light_sampler::LightSampler;
+use candela_core::sampler::Pcg32;
+use glam::Vec3;
+
+/// 64 lights around the origin with powers log-uniform over three decades: triangles
+/// facing in random directions (some away from every test point), spheres and points.
+fn lights() -> Vec<Light> {
+    let mut rng = Pcg32::new(7, 1);
+    let mut u = move || rng.uniform_f32();
+    let mut out = Vec::new();
+    for i in 0..64 {
+        let c = Vec3::new(8.0 * u() - 4.0, 3.0 * u() + 0.5, 8.0 * u() - 4.0);
+        let scale = 10f32.powf(3.0 * u());
+        let color = Vec3::new(0.2 + u(), 0.2 + u(), 0.2 + u()) * scale;
+        out.push(match i % 4 {
+            0 | 1 => {
+                let a = Vec3::new(u() - 0.5, u() - 0.5, u() - 0.5) * 0.6;
+                let b = Vec3::new(u() - 0.5, u() - 0.5, u() - 0.5) * 0.6;
+                let n = a.cross(b).normalize();
+                Light::Triangle(TriangleLight::new([c, c + a, c + b], n, color))
+            }
+            2 => Light::Sphere(SphereLight {
+                center: c,
+                radius: 0.05 + 0.1 * u(),
+                le: color,
+                inward: false,
+            }),
+            _ => Light::Point(PointLight {
+                position: c,
+                intensity: color,
+            }),
+        });
+    }
+    out
+}
+
+fn contexts() -> [ShadingCtx; 4] {
+    [
+        ShadingCtx {
+            p: Vec3::ZERO,
+            n: Vec3::Y,
+        },
+        ShadingCtx {
+            p: Vec3::new(3.0, 0.0, -3.0),
+            n: Vec3::new(-1.0, 1.0, 0.0).normalize(),
+        },
+        ShadingCtx {
+            p: Vec3::new(0.5, 2.0, 0.5),
+            n: Vec3::ZERO,
+        },
+        ShadingCtx {
+            p: Vec3::new(-6.0, 1.0, 6.0),
+            n: Vec3::X,
+        },
+    ]
+}
+
+/// Upper α-quantile of χ² with k degrees of freedom (Wilson & Hilferty 1931), for the
+/// standard normal quantile `z` of α.
+fn chi2_critical(k: f64, z: f64) -> f64 {
+    let a = 2.0 / (9.0 * k);
+    k * (1.0 - a + z * a.sqrt()).powi(3)
+}
+
+/// Pearson's statistic of `observed` against `expected` counts with small bins pooled;
+/// returns (statistic, degrees of freedom).
+fn chi2_statistic(observed: &[u64], expected: &[f64]) -> (f64, f64) {
+    let mut stat = 0.0;
+    let mut bins = 0;
+    let (mut pool_o, mut pool_e) = (0.0, 0.0);
+    for (&o, &e) in observed.iter().zip(expected) {
+        if e < 5.0 {
+            pool_o += o as f64;
+            pool_e += e;
+        } else {
+            stat += (o as f64 - e).powi(2) / e;
+            bins += 1;
+        }
+    }
+    if pool_e > 0.0 {
+        stat += (pool_o - pool_e).powi(2) / pool_e.max(1e-9);
+        bins += 1;
+    }
+    (stat, (bins - 1) as f64)
+}
+
+const SAMPLES: usize = 200_000;
+
+#[test]
+fn pmfs_sum_to_one_and_match_pick_frequencies() {
+    let lights = lights();
+    // α = 10⁻⁴ per test (z = 3.719), 20 tests: family-wise false alarm rate 0.2%.
+    let z_alpha = 3.719;
+    for kind in [
+        LightSamplerKind::Uniform,
+        LightSamplerKind::Power,
+        LightSamplerKind::Array,
+        LightSamplerKind::Bvh,
+    ] {
+        let sampler = LightSampler::new(kind, 8, &lights);
+        for (ci, ctx) in contexts().iter().enumerate() {
+            let pmf: Vec<f64> = (0..lights.len() as u32)
+                .map(|i| sampler.pmf(ctx, LightId(i)) as f64)
+                .collect();
+            let total: f64 = pmf.iter().sum();
+            assert!(
+                (total - 1.0).abs() < 1e-4,
+                "{kind:?} ctx {ci}: Σpmf = {total}"
+            );
+            let mut counts = vec![0u64; lights.len()];
+            let mut rng = Pcg32::new(11, ci as u64);
+            for _ in 0..SAMPLES {
+                let pick = sampler
+                    .sample(ctx, rng.uniform_f32(), &lights)
+                    .expect("some light reaches every test point");
+                let i = pick.id.0 as usize;
+                // The pmf a pick reports is the one `pmf` gives for MIS.
+                assert!((pick.pmf as f64 / pmf[i] - 1.0).abs() < 1e-4);
+                assert_eq!(pick.pmf, pick.mis_pmf);
+                counts[i] += 1;
+            }
+            for (i, (&c, &p)) in counts.iter().zip(&pmf).enumerate() {
+                assert!(p > 0.0 || c == 0, "{kind:?}: light {i} picked at pmf 0");
+            }
+            let expected: Vec<f64> = pmf.iter().map(|p| p * SAMPLES as f64).collect();
+            let (stat, dof) = chi2_statistic(&counts, &expected);
+            let crit = chi2_critical(dof, z_alpha);
+            eprintln!("{kind:?} ctx {ci}: χ² = {stat:.1}, dof {dof}, critical {crit:.1}");
+            assert!(
+                stat < crit,
+                "{kind:?} ctx {ci}: χ² = {stat} ≥ {crit} (dof {dof})"
+            );
+        }
+    }
+}
+
+#[test]
+fn bvh_gives_zero_only_to_lights_that_cannot_reach_the_point() {
+    let lights = lights();
+    let sampler = LightSampler::new(LightSamplerKind::Bvh, 8, &lights);
+    for ctx in contexts() {
+        for (i, l) in lights.iter().enumerate() {
+            if sampler.pmf(&ctx, LightId(i as u32)) == 0.0 {
+                // Zero only for one-sided triangles seen from behind.
+                let Light::Triangle(t) = l else {
+                    panic!("light {i} ({l:?}) got pmf 0 at {ctx:?}");
+                };
+                assert!((ctx.p - t.p[0]).dot(t.n) <= 0.0, "triangle {i} got pmf 0");
+            }
+        }
+    }
+}
+
+#[test]
+fn array_rounding_leaves_no_emitting_light_without_slots() {
+    use candela_core::light_sampler::LightArray;
+    // One light 10⁹ times brighter than the others: they would round to zero slots.
+    let mut powers = vec![1.0f32; 100];
+    powers[0] = 1e9;
+    powers[1] = 0.0;
+    let a = LightArray::new(&powers).unwrap();
+    assert_eq!(a.pmf(1), 0.0);
+    let total: f64 = (0..100).map(|i| a.pmf(i) as f64).sum();
+    assert!((total - 1.0).abs() < 1e-5);
+    assert!((2..100).all(|i| a.pmf(i) > 0.0));
+    assert!(a.len() >= 400 - 1 && a.len() <= 400 + 100);
+}
+
+/// RIS picks are not described by a tractable pmf; what must hold is that for every
+/// light i, E[1{pick = i} / pick.pmf] = 1 if the light can contribute (target > 0), and 0
+/// otherwise: unbiasedness of the RIS weight, light by light. Lights RIS rarely picks give
+/// heavy-tailed estimates, so the per-light z-test covers lights picked ≥ 400 times, and
+/// sums over all lights, E[Σᵢ gᵢ 1{pick = i} / pick.pmf] = Σᵢ gᵢ, cover the rest for
+/// g = the target (the variance RIS minimizes) and g = 1 (every light counted once).
+#[test]
+fn ris_weight_is_unbiased_for_every_light() {
+    let lights = lights();
+    for kind in [LightSamplerKind::Ris, LightSamplerKind::RisBvh] {
+        for m in [1, 4] {
+            let sampler = LightSampler::new(kind, m, &lights);
+            for (ci, ctx) in contexts().iter().enumerate() {
+                let target: Vec<f64> = lights.iter().map(|l| l.importance(ctx) as f64).collect();
+                let mut count = vec![0u64; lights.len()];
+                let mut sum = vec![0.0f64; lights.len()];
+                let mut sum2 = vec![0.0f64; lights.len()];
+                let (mut g_target, mut g_target2) = (0.0f64, 0.0f64);
+                let mut rng = Pcg32::new(13, ci as u64);
+                for _ in 0..SAMPLES {
+                    let Some(pick) = sampler.sample(ctx, rng.uniform_f32(), &lights) else {
+                        continue;
+                    };
+                    let i = pick.id.0 as usize;
+                    let x = 1.0 / pick.pmf as f64;
+                    count[i] += 1;
+                    sum[i] += x;
+                    sum2[i] += x * x;
+                    g_target += target[i] * x;
+                    g_target2 += (target[i] * x).powi(2);
+                    // The MIS surrogate is the source's pmf, and is never zero for a pick.
+                    assert_eq!(pick.mis_pmf, sampler.pmf(ctx, pick.id));
+                    assert!(pick.mis_pmf > 0.0);
+                }
+                let n = SAMPLES as f64;
+                let z_of = |s: f64, s2: f64, expected: f64| {
+                    let mean = s / n;
+                    let var = (s2 / n - mean * mean).max(0.0);
+                    (mean - expected) / (var / n).sqrt().max(1e-12 * expected)
+                };
+                // 64 lights × 4 points × 4 settings ≈ 1000 tests; α = 10⁻⁶ each (|z| < 4.9)
+                // keeps the family-wise false alarm rate near 0.1%.
+                let z_max = 4.9;
+                let mut worst: f64 = 0.0;
+                for i in 0..lights.len() {
+                    if target[i] == 0.0 {
+                        assert_eq!(count[i], 0, "light {i} without target was picked");
+                    } else if count[i] >= 400 {
+                        let z = z_of(sum[i], sum2[i], 1.0);
+                        worst = worst.max(z.abs());
+                        assert!(z.abs() < z_max, "{kind:?} M={m} ctx {ci} light {i}: z {z}");
+                    }
+                }
+                let reachable = target.iter().filter(|&&t| t > 0.0).count() as f64;
+                let (s1, s2) = (sum.iter().sum::<f64>(), sum2.iter().sum::<f64>());
+                // Σ over lights of 1{pick = i}/pmf: the same variable as sum of x per pick.
+                let z_count = z_of(s1, s2, reachable);
+                let z_target = z_of(g_target, g_target2, target.iter().sum());
+                eprintln!(
+                    "{kind:?} M={m} ctx {ci}: max per-light |z| = {worst:.2}, \
+                     z(Σ1) = {z_count:.2}, z(Σtarget) = {z_target:.2}"
+                );
+                assert!(z_count.abs() < z_max && z_target.abs() < z_max);
+            }
+        }
+    }
+}
