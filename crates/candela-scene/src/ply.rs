@@ -184,3 +184,143 @@ fn check_sizes(header: &Header, body: usize) -> Result<(), String> {
     }
     Ok(())
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn parse(bytes: &[u8]) -> Result<MeshDesc, MeshError> {
+        parse_ply(bytes, Path::new("m.ply"))
+    }
+
+    const ASCII_QUAD: &str = "ply\nformat ascii 1.0\ncomment a unit quad\n\
+        element vertex 4\nproperty float x\nproperty float y\nproperty float z\n\
+        property float nx\nproperty float ny\nproperty float nz\n\
+        property float s\nproperty float t\n\
+        element face 1\nproperty list uchar int vertex_indices\nend_header\n\
+        0 0 0 0 0 1 0 0\n1 0 0 0 0 1 1 0\n1 1 0 0 0 1 1 1\n0 1 0 0 0 1 0 1\n4 0 1 2 3\n";
+
+    #[test]
+    fn ascii_polygons_become_fans_with_normals_and_uvs() {
+        let mesh = parse(ASCII_QUAD.as_bytes()).unwrap();
+        assert_eq!(mesh.positions.len(), 4);
+        assert_eq!(mesh.indices, vec![[0, 1, 2], [0, 2, 3]]);
+        assert_eq!(mesh.normals, vec![Vec3::Z; 4]);
+        for (p, uv) in mesh.positions.iter().zip(&mesh.uvs) {
+            assert_eq!(p.truncate(), *uv);
+        }
+    }
+
+    /// A binary PLY of one triangle (positions as doubles, `vertex_index` with uint
+    /// counts), in either byte order.
+    fn binary_triangle(big_endian: bool) -> Vec<u8> {
+        let format = if big_endian {
+            "binary_big_endian"
+        } else {
+            "binary_little_endian"
+        };
+        let mut bytes = format!(
+            "ply\nformat {format} 1.0\nelement vertex 3\nproperty double x\n\
+             property double y\nproperty double z\nproperty float u\nproperty float v\n\
+             element face 1\nproperty list uint int vertex_index\nend_header\n"
+        )
+        .into_bytes();
+        let f64b = |v: f64| {
+            if big_endian {
+                v.to_be_bytes()
+            } else {
+                v.to_le_bytes()
+            }
+        };
+        let f32b = |v: f32| {
+            if big_endian {
+                v.to_be_bytes()
+            } else {
+                v.to_le_bytes()
+            }
+        };
+        let u32b = |v: u32| {
+            if big_endian {
+                v.to_be_bytes()
+            } else {
+                v.to_le_bytes()
+            }
+        };
+        for p in [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 2.0, 0.0]] {
+            for c in p {
+                bytes.extend(f64b(c));
+            }
+            bytes.extend(f32b(p[0] as f32));
+            bytes.extend(f32b(p[1] as f32));
+        }
+        bytes.extend(u32b(3));
+        for i in [0u32, 1, 2] {
+            bytes.extend(u32b(i));
+        }
+        bytes
+    }
+
+    #[test]
+    fn binary_files_of_both_byte_orders_load() {
+        for big_endian in [false, true] {
+            let mesh = parse(&binary_triangle(big_endian)).unwrap();
+            assert_eq!(mesh.positions[2], Vec3::new(0.0, 2.0, 0.0));
+            assert_eq!(mesh.uvs[1], Vec2::new(1.0, 0.0));
+            assert!(mesh.normals.is_empty());
+            assert_eq!(mesh.indices, vec![[0, 1, 2]]);
+        }
+    }
+
+    #[test]
+    fn every_truncation_of_a_binary_file_is_an_error() {
+        let bytes = binary_triangle(false);
+        for len in 0..bytes.len() {
+            assert!(parse(&bytes[..len]).is_err(), "truncated to {len} bytes");
+        }
+    }
+
+    #[test]
+    fn huge_declared_counts_are_rejected_before_reading() {
+        let text = "ply\nformat binary_little_endian 1.0\nelement vertex 4000000000\n\
+            property float x\nproperty float y\nproperty float z\n\
+            element face 1\nproperty list uchar int vertex_indices\nend_header\n\0\0\0\0";
+        let e = parse(text.as_bytes()).unwrap_err();
+        assert!(e.message.contains("truncated or corrupt"), "{e}");
+        assert!(e.to_string().starts_with("m.ply: "), "{e}");
+    }
+
+    #[test]
+    fn a_huge_list_count_is_an_error() {
+        let mut bytes = binary_triangle(false);
+        let at = bytes.len() - 16; // the face's list count
+        bytes[at..at + 4].copy_from_slice(&u32::MAX.to_le_bytes());
+        assert!(parse(&bytes).is_err());
+    }
+
+    #[test]
+    fn malformed_files_are_errors() {
+        let quad = ASCII_QUAD;
+        let cases = [
+            ("not a ply file".to_string(), ""),
+            (quad.replace("4 0 1 2 3", "4 0 1 2 9"), "out of range"),
+            (quad.replace("4 0 1 2 3", "2 0 1"), "has 2 vertices"),
+            (quad.replace("1 1 0 0 0 1 1 1", "1 x 0 0 0 1 1 1"), ""),
+            (quad.replace("element face 1", "element face 0"), "no faces"),
+            (quad.replace("vertex_indices", "corners"), "vertex_indices"),
+            (quad.replace("property float z\n", ""), "x, y or z"),
+        ];
+        for (text, needle) in cases {
+            let e = parse(text.as_bytes()).unwrap_err();
+            assert!(e.message.contains(needle), "{e}");
+            assert!(!e.message.contains('\n'), "{e:?}");
+        }
+    }
+
+    #[test]
+    fn ascii_errors_name_the_line() {
+        let text = ASCII_QUAD.replace("1 1 0 0 0 1 1 1", "1 x 0 0 0 1 1 1");
+        let e = parse(text.as_bytes()).unwrap_err();
+        // The header takes 15 lines; the bad vertex is the third after it.
+        assert_eq!(e.line, Some(18), "{e}");
+    }
+}
