@@ -4,6 +4,27 @@
 //! One module per format: [`toml_scene`] reads Candela's own scene format (see
 //! `docs/scene-format.md`), [`obj`] and [`ply`] read triangle meshes. A new scene format
 //! plugs in as a module and one arm of the match in [`load_scene`].
+//!
+//! ```
+//! use std::path::Path;
+//!
+//! let text = r#"
+//! [materials.white]
+//! type = "diffuse"
+//! albedo = 0.8
+//!
+//! [[shape]]
+//! type = "sphere"
+//! material = "white"
+//! emission = 1
+//! "#;
+//! let desc = candela_scene::parse_toml_scene(text, Path::new("scene.toml")).unwrap();
+//! assert_eq!(desc.shapes.len(), 1);
+//! assert!(candela_core::build::build(&desc).is_ok());
+//!
+//! let err = candela_scene::parse_toml_scene("[camera]\nfvo = 3", Path::new("s.toml"));
+//! assert!(err.unwrap_err().to_string().starts_with("s.toml:2:1: unknown field `fvo`"));
+//! ```
 
 use std::fmt;
 use std::path::{Path, PathBuf};
@@ -101,12 +122,8 @@ pub fn load_scene(path: &Path) -> Result<SceneDesc, LoadError> {
         .unwrap_or_default();
     match ext.as_str() {
         "toml" => {
-            let text = std::fs::read_to_string(path).map_err(|e| {
-                LoadError::new(
-                    Span::new(path.display().to_string(), 0, 0),
-                    format!("cannot read scene file: {e}"),
-                )
-            })?;
+            let text = std::fs::read_to_string(path)
+                .map_err(|e| LoadError::new(file_span(), format!("cannot read scene file: {e}")))?;
             parse_toml_scene(&text, path)
         }
         "" => Err(LoadError::new(
@@ -192,7 +209,7 @@ mod tests {
         let e = load_scene(Path::new("/nonexistent/scene.toml")).unwrap_err();
         assert!(
             e.to_string()
-                .starts_with("/nonexistent/scene.toml: cannot read"),
+                .starts_with("/nonexistent/scene.toml:1:1: cannot read"),
             "{e}"
         );
     }

@@ -166,6 +166,10 @@ fn min_element_size(element: &ElementDef, encoding: Encoding) -> u64 {
 fn check_sizes(header: &Header, body: usize) -> Result<(), String> {
     let mut need: u128 = 0;
     for element in header.elements.values() {
+        if element.properties.is_empty() && element.count > 0 {
+            // Costs no bytes per element, so its count is bounded by nothing.
+            return Err(format!("PLY element `{}` has no properties", element.name));
+        }
         need += element.count as u128 * min_element_size(element, header.encoding) as u128;
     }
     // An ascii file's last line may lack its newline.
@@ -290,6 +294,14 @@ mod tests {
     }
 
     #[test]
+    fn an_element_without_properties_is_an_error() {
+        let text = "ply\nformat binary_little_endian 1.0\nelement junk 4000000000\n\
+            element vertex 0\nproperty float x\nend_header\n";
+        let e = parse(text.as_bytes()).unwrap_err();
+        assert_eq!(e.to_string(), "m.ply: PLY element `junk` has no properties");
+    }
+
+    #[test]
     fn a_huge_list_count_is_an_error() {
         let mut bytes = binary_triangle(false);
         let at = bytes.len() - 16; // the face's list count
@@ -304,6 +316,7 @@ mod tests {
             ("not a ply file".to_string(), ""),
             (quad.replace("4 0 1 2 3", "4 0 1 2 9"), "out of range"),
             (quad.replace("4 0 1 2 3", "2 0 1"), "has 2 vertices"),
+            (quad.replace("4 0 1 2 3", "3 0 -1 2"), "face 0"),
             (quad.replace("1 1 0 0 0 1 1 1", "1 x 0 0 0 1 1 1"), ""),
             (quad.replace("element face 1", "element face 0"), "no faces"),
             (quad.replace("vertex_indices", "corners"), "vertex_indices"),

@@ -143,6 +143,7 @@ const SHAPE_TYPES: &[&str] = &["mesh", "sphere", "rectangle", "disk", "cube"];
 pub(crate) fn parse_shape(src: &Source, base: &Path, item: Item) -> Result<ShapeDesc, LoadError> {
     let at = item.span().start;
     let kind = item_type(src, "shape", &item, SHAPE_TYPES)?;
+    check_transform_steps(src, &item)?;
     let (geometry, common) = match kind {
         "mesh" => {
             let e: MeshEntry = deserialize(src, item)?;
@@ -213,6 +214,30 @@ pub(crate) fn parse_shape(src: &Source, base: &Path, item: Item) -> Result<Shape
         flip_normals: common.flip_normals.unwrap_or(false),
         span: src.span(at),
     })
+}
+
+/// Gives a step with several keys a clearer error than serde's enum message.
+fn check_transform_steps(src: &Source, item: &Item) -> Result<(), LoadError> {
+    let steps = item.get_ref().as_table().and_then(|t| t.get("transform"));
+    let Some(steps) = steps.and_then(|s| s.get_ref().as_array()) else {
+        return Ok(()); // absent, or a wrong type that serde reports
+    };
+    for step in steps.iter() {
+        match step.get_ref().as_table() {
+            Some(t) if t.len() != 1 => {
+                return Err(src.error(
+                    step.span().start,
+                    format!(
+                        "a transform step must have exactly one key (`translate`, `rotate`, \
+                         `scale`, `matrix` or `look_at`), found {}",
+                        t.len()
+                    ),
+                ))
+            }
+            _ => {}
+        }
+    }
+    Ok(())
 }
 
 fn mesh_file(src: &Source, base: &Path, file: Spanned<String>) -> Result<MeshDesc, LoadError> {

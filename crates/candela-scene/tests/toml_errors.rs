@@ -254,6 +254,17 @@ fn transform_errors() {
         error(&format!("{shape}{{ matrix = [1, 0, 0, 1] }}]\n")),
         "scene.toml:4:25: expected an array of 16 numbers, found 4"
     );
+    assert_eq!(
+        error(&format!("{shape}{{ translate = [1, 0, 0], scale = 2 }}]\n")),
+        "scene.toml:4:14: a transform step must have exactly one key (`translate`, `rotate`, \
+         `scale`, `matrix` or `look_at`), found 2"
+    );
+    assert_eq!(
+        error(&format!(
+            "{shape}{{ rotate = {{ axis = [0, 1, 0], angle = 3, by = 1 }} }}]\n"
+        )),
+        "scene.toml:4:56: unexpected keys in table: by, available keys: axis, angle"
+    );
     let e = error(&format!(
         "{shape}{{ translate = [0, 0, 0] }}, {{ look_at = {{ origin = [0, 0, 0], \
          target = [0, 5, 0] }} }}]\n"
