@@ -16,6 +16,9 @@ use crate::sampling::ONE_MINUS_EPSILON;
 const BUCKETS: usize = 12;
 /// Subtrees with more lights than this are built in parallel.
 const PARALLEL_MIN: usize = 4096;
+/// Nodes of at most this many lights split at the median of the longest axis: the SAOH
+/// evaluation per node costs ~50 transcendental calls, and most nodes are small.
+const MEDIAN_MAX: usize = 8;
 /// Beyond this depth splits fall back to the median, so that trails fit in 64 bits.
 const MAX_SAOH_DEPTH: u32 = 40;
 
@@ -35,12 +38,6 @@ pub struct LightBvh {
     /// Per light: the branch taken at each level (bit d = level d, 1 = second child),
     /// with a leading 1 marking the depth; 0 where the light is not in the tree.
     trails: Vec<u64>,
-}
-
-/// A node under construction.
-enum Tree {
-    Leaf(LightBounds, u32),
-    Interior(LightBounds, Box<Tree>, Box<Tree>),
 }
 
 struct Item {
@@ -75,36 +72,35 @@ impl LightBvh {
             trails: vec![0; lights.len()],
         };
         if !items.is_empty() {
-            let tree = build(&mut items, 0);
-            bvh.flatten(tree, 1);
+            // A subtree over n lights has exactly 2n − 1 nodes, so every subtree's place in
+            // the depth-first array is known before it is built: the build writes into
+            // disjoint slices in parallel, without an intermediate tree.
+            let dummy = Node {
+                bounds: items[0].bounds,
+                index: 0,
+                is_leaf: true,
+            };
+            bvh.nodes = vec![dummy; 2 * items.len() - 1];
+            build(&mut items, 0, &mut bvh.nodes, 0);
+            bvh.set_trails();
         }
         Some(bvh)
     }
 
-    fn flatten(&mut self, tree: Tree, trail: u64) {
-        match tree {
-            Tree::Leaf(bounds, light) => {
-                self.trails[light as usize] = trail;
-                self.nodes.push(Node {
-                    bounds,
-                    index: light,
-                    is_leaf: true,
-                });
+    /// Records, for every light in the tree, the branches from the root to its leaf.
+    fn set_trails(&mut self) {
+        let mut stack = vec![(0usize, 1u64)];
+        while let Some((at, trail)) = stack.pop() {
+            let node = &self.nodes[at];
+            if node.is_leaf {
+                self.trails[node.index as usize] = trail;
+                continue;
             }
-            Tree::Interior(bounds, a, b) => {
-                let at = self.nodes.len();
-                self.nodes.push(Node {
-                    bounds,
-                    index: 0,
-                    is_leaf: false,
-                });
-                // Move the depth marker one bit up; the bit it leaves is the branch.
-                let depth = 63 - trail.leading_zeros();
-                let child = (trail & !(1 << depth)) | (1 << (depth + 1));
-                self.flatten(*a, child);
-                self.nodes[at].index = self.nodes.len() as u32;
-                self.flatten(*b, child | (1 << depth));
-            }
+            // Move the depth marker one bit up; the bit it leaves is the branch.
+            let depth = 63 - trail.leading_zeros();
+            let child = (trail & !(1 << depth)) | (1 << (depth + 1));
+            stack.push((at + 1, child));
+            stack.push((node.index as usize, child | (1 << depth)));
         }
     }
 
@@ -206,25 +202,48 @@ fn cost(b: &LightBounds, kr: f32) -> f32 {
     b.intensity * cone_measure(b.cos_theta_o, b.cos_theta_e) * b.aabb.surface_area() * kr
 }
 
-fn build(items: &mut [Item], depth: u32) -> Tree {
+/// Builds the subtree over `items` into `nodes` (exactly 2·len − 1 of them), whose first
+/// node has index `base` in the whole array.
+fn build(items: &mut [Item], depth: u32, nodes: &mut [Node], base: u32) {
     if items.len() == 1 {
-        return Tree::Leaf(items[0].bounds, items[0].light);
+        nodes[0] = Node {
+            bounds: items[0].bounds,
+            index: items[0].light,
+            is_leaf: true,
+        };
+        return;
     }
     let mid = split(items, depth);
     let (left, right) = items.split_at_mut(mid);
-    let (a, b) = if left.len() + right.len() > PARALLEL_MIN {
-        join(|| build(left, depth + 1), || build(right, depth + 1))
+    let (head, rest) = nodes.split_at_mut(1);
+    let (left_nodes, right_nodes) = rest.split_at_mut(2 * mid - 1);
+    let right_base = base + 2 * mid as u32;
+    if left.len() + right.len() > PARALLEL_MIN {
+        join(
+            || build(left, depth + 1, left_nodes, base + 1),
+            || build(right, depth + 1, right_nodes, right_base),
+        );
     } else {
-        (build(left, depth + 1), build(right, depth + 1))
+        build(left, depth + 1, left_nodes, base + 1);
+        build(right, depth + 1, right_nodes, right_base);
+    }
+    head[0] = Node {
+        bounds: LightBounds::union(&left_nodes[0].bounds, &right_nodes[0].bounds),
+        index: right_base,
+        is_leaf: false,
     };
-    let bounds = LightBounds::union(bounds_of(&a), bounds_of(&b));
-    Tree::Interior(bounds, Box::new(a), Box::new(b))
 }
 
-fn bounds_of(t: &Tree) -> &LightBounds {
-    match t {
-        Tree::Leaf(b, _) | Tree::Interior(b, _, _) => b,
+/// cos of the half-angle of the smallest cone about `axis` that holds the cone (`w`,
+/// `cos_t`): cos(∠(axis, w) + θ), or −1 past π; widened by a hair against round-off.
+fn cos_containing(axis: glam::Vec3, w: glam::Vec3, cos_t: f32) -> f32 {
+    let c = axis.dot(w).clamp(-1.0, 1.0);
+    if cos_t < -c {
+        return -1.0;
     }
+    let s = (1.0 - c * c).max(0.0).sqrt();
+    let sin_t = (1.0 - cos_t * cos_t).max(0.0).sqrt();
+    (c * cos_t - s * sin_t - 1e-5).max(-1.0)
 }
 
 /// Reorders `items` and returns the split point: the cheapest bucket boundary by SAOH
@@ -247,37 +266,73 @@ fn split(items: &mut [Item], depth: u32) -> usize {
     } else {
         2
     };
-    if ext[axis] <= 0.0 || depth >= MAX_SAOH_DEPTH || n <= 2 {
+    if ext[axis] <= 0.0 || depth >= MAX_SAOH_DEPTH || n <= MEDIAN_MAX {
         return median(items, axis);
     }
     let bucket_of = |c: glam::Vec3| {
         (((c[axis] - lo[axis]) / ext[axis] * BUCKETS as f32) as usize).min(BUCKETS - 1)
     };
+    // Bucket bounds in two passes without trigonometry (the pairwise cone union costs
+    // three arccosines, and this loop runs N times per tree level): first boxes, sums and
+    // the mean normal direction, then each bucket's cone about that mean, wide enough to
+    // hold every member's cone.
     let mut buckets: [Option<LightBounds>; BUCKETS] = [None; BUCKETS];
+    let mut axis_sum = [glam::Vec3::ZERO; BUCKETS];
     for it in items.iter() {
-        let b = &mut buckets[bucket_of(it.centroid)];
+        let k = bucket_of(it.centroid);
+        axis_sum[k] += it.bounds.w;
+        let b = &mut buckets[k];
         *b = Some(match b {
-            Some(acc) => LightBounds::union(acc, &it.bounds),
-            None => it.bounds,
+            Some(acc) => LightBounds {
+                aabb: acc.aabb.union(it.bounds.aabb),
+                intensity: acc.intensity + it.bounds.intensity,
+                cos_theta_e: acc.cos_theta_e.min(it.bounds.cos_theta_e),
+                two_sided: acc.two_sided || it.bounds.two_sided,
+                ..*acc
+            },
+            None => LightBounds {
+                cos_theta_o: 1.0,
+                ..it.bounds
+            },
         });
+    }
+    for (b, sum) in buckets.iter_mut().zip(axis_sum) {
+        if let Some(b) = b {
+            b.w = sum.try_normalize().unwrap_or(glam::Vec3::Z);
+        }
+    }
+    for it in items.iter() {
+        let b = buckets[bucket_of(it.centroid)]
+            .as_mut()
+            .expect("filled above");
+        b.cos_theta_o = b
+            .cos_theta_o
+            .min(cos_containing(b.w, it.bounds.w, it.bounds.cos_theta_o));
     }
     let whole = buckets
         .iter()
         .flatten()
-        .copied()
-        .reduce(|a, b| LightBounds::union(&a, &b))
-        .expect("at least one light");
-    let diag = whole.aabb.extent();
+        .fold(crate::geometry::Aabb::EMPTY, |acc, b| acc.union(b.aabb));
+    let diag = whole.extent();
     let kr = diag.max_element() / diag[axis].max(f32::MIN_POSITIVE);
-    let merge = |bs: &[Option<LightBounds>]| {
-        bs.iter()
-            .flatten()
-            .copied()
-            .reduce(|a, b| LightBounds::union(&a, &b))
+    // Bounds of buckets [0, cut) from a forward sweep, of [cut, BUCKETS) from a backward
+    // one: 2·BUCKETS unions per node.
+    let sweep = |order: &mut dyn Iterator<Item = usize>| {
+        let mut acc: Option<LightBounds> = None;
+        let mut out = [None; BUCKETS];
+        for b in order {
+            if let Some(x) = &buckets[b] {
+                acc = Some(acc.map_or(*x, |a| LightBounds::union(&a, x)));
+            }
+            out[b] = acc;
+        }
+        out
     };
+    let below = sweep(&mut (0..BUCKETS));
+    let above = sweep(&mut (0..BUCKETS).rev());
     let mut best = (f32::INFINITY, 0usize);
     for cut in 1..BUCKETS {
-        let (Some(a), Some(b)) = (merge(&buckets[..cut]), merge(&buckets[cut..])) else {
+        let (Some(a), Some(b)) = (below[cut - 1], above[cut]) else {
             continue;
         };
         let c = cost(&a, kr) + cost(&b, kr);
