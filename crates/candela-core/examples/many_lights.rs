@@ -137,8 +137,10 @@ fn settings(width: u32, height: u32) -> RenderSettings {
 /// A 20×20 floor with boxes under a 32×32 grid of small lamps (1024 lights, 2048
 /// triangles) of random colour and log-uniform power over two decades.
 fn grid_scene() -> SceneDesc {
-    let mut d = SceneDesc::default();
-    d.render = settings(160, 120);
+    let mut d = SceneDesc {
+        render: settings(160, 120),
+        ..Default::default()
+    };
     material(&mut d);
     d.camera = CameraDesc {
         position: Vec3::new(0.0, 7.0, 12.0),
@@ -171,8 +173,10 @@ fn grid_scene() -> SceneDesc {
 /// emissive triangles) along both walls; the camera stands near one end, so most lamps
 /// are far from most shading points.
 fn street_scene() -> SceneDesc {
-    let mut d = SceneDesc::default();
-    d.render = settings(192, 96);
+    let mut d = SceneDesc {
+        render: settings(192, 96),
+        ..Default::default()
+    };
     material(&mut d);
     d.camera = CameraDesc {
         position: Vec3::new(0.0, 2.0, 195.0),
@@ -266,7 +270,10 @@ fn main() {
             let (film, spp) = render_for(&scene, seconds);
             println!("  {kname:8} {spp:6} {:10.5}", rel_mse(&film, &reference));
         }
-        for (kind, kname) in [(LightSamplerKind::Ris, "ris"), (LightSamplerKind::RisBvh, "ris-bvh")] {
+        for (kind, kname) in [
+            (LightSamplerKind::Ris, "ris"),
+            (LightSamplerKind::RisBvh, "ris-bvh"),
+        ] {
             println!("  {kname} candidates at equal time:");
             for m in [1, 2, 4, 8, 16] {
                 let scene = scene_with(&desc, kind, m, 1);

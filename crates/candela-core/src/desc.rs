@@ -189,7 +189,7 @@ pub enum LightSamplerKind {
 }
 
 /// Default number of RIS candidates, chosen by `bench/many_lights`.
-pub const DEFAULT_RIS_CANDIDATES: u32 = 8;
+pub const DEFAULT_RIS_CANDIDATES: u32 = 2;
 
 /// Render settings a scene carries; the command line may override them.
 #[derive(Clone, Debug)]

@@ -13,16 +13,18 @@ const RES: u32 = 24;
 const TILE: u32 = 6;
 
 fn scene(kind: LightSamplerKind, seed: u64) -> candela_core::Scene {
-    let mut d = SceneDesc::default();
-    d.render = RenderSettings {
-        width: RES,
-        height: RES,
-        spp: 1,
-        max_depth: 2,
-        seed,
-        mis: MisMode::Balance,
-        light_sampler: kind,
-        ris_candidates: 4,
+    let mut d = SceneDesc {
+        render: RenderSettings {
+            width: RES,
+            height: RES,
+            spp: 1,
+            max_depth: 2,
+            seed,
+            mis: MisMode::Balance,
+            light_sampler: kind,
+            ris_candidates: 4,
+        },
+        ..Default::default()
     };
     d.camera = CameraDesc {
         position: Vec3::new(0.0, 6.0, 7.0),

@@ -80,29 +80,70 @@ impl LightBounds {
     /// that transmitting surfaces are not cut off. Zero only where the cones prove that
     /// no emission reaches the point.
     pub fn importance(&self, ctx: &ShadingCtx) -> f32 {
-        let pc = self.aabb.center();
-        let d2 = ctx.p.distance_squared(pc);
-        // Clamp the distance so that points near or inside the box do not blow up.
-        let d2 = d2.max(self.aabb.extent().length() * 0.5);
-        let wi = (ctx.p - pc).normalize_or_zero();
+        ImportanceBounds::new(self).importance(ctx)
+    }
+}
+
+/// [`LightBounds`] in the form the importance needs, precomputed once per BVH node:
+/// the box's bounding sphere and sin θ_o.
+#[derive(Clone, Copy, Debug)]
+pub struct ImportanceBounds {
+    center: Vec3,
+    radius: f32,
+    w: Vec3,
+    intensity: f32,
+    cos_theta_o: f32,
+    sin_theta_o: f32,
+    cos_theta_e: f32,
+    two_sided: bool,
+}
+
+impl ImportanceBounds {
+    pub fn new(b: &LightBounds) -> ImportanceBounds {
+        let center = b.aabb.center();
+        ImportanceBounds {
+            center,
+            radius: (b.aabb.max - center).length(),
+            w: b.w,
+            intensity: b.intensity,
+            cos_theta_o: b.cos_theta_o,
+            sin_theta_o: safe_sqrt(1.0 - b.cos_theta_o * b.cos_theta_o),
+            cos_theta_e: b.cos_theta_e,
+            two_sided: b.two_sided,
+        }
+    }
+
+    /// See [`LightBounds::importance`].
+    #[inline]
+    pub fn importance(&self, ctx: &ShadingCtx) -> f32 {
+        let to = ctx.p - self.center;
+        let d2 = to.length_squared();
+        let inv_d = if d2 > 0.0 { d2.sqrt().recip() } else { 0.0 };
+        let wi = if d2 > 0.0 { to * inv_d } else { Vec3::Z };
+        // Clamp the distance so that points near or inside the box do not blow up (pbrt
+        // clamps d² by half the box diagonal).
+        let d2c = d2.max(self.radius);
         let mut cos_w = self.w.dot(wi);
         if self.two_sided {
             cos_w = cos_w.abs();
         }
         let sin_w = safe_sqrt(1.0 - cos_w * cos_w);
-        // The cone of directions from the point that the box subtends.
-        let cos_b = bound_subtended_cos(&self.aabb, ctx.p);
-        let sin_b = safe_sqrt(1.0 - cos_b * cos_b);
+        // The cone of directions from the point that the box's bounding sphere subtends.
+        let (sin_b, cos_b) = if d2 <= self.radius * self.radius {
+            (0.0, -1.0)
+        } else {
+            let sin_b = self.radius * inv_d;
+            (sin_b, safe_sqrt(1.0 - sin_b * sin_b))
+        };
         // θ' = max(0, θ_w − θ_o − θ_b): the smallest angle between an emitter's normal
         // and the direction to the point.
-        let sin_o = safe_sqrt(1.0 - self.cos_theta_o * self.cos_theta_o);
-        let cos_x = cos_sub_clamped(sin_w, cos_w, sin_o, self.cos_theta_o);
-        let sin_x = sin_sub_clamped(sin_w, cos_w, sin_o, self.cos_theta_o);
+        let cos_x = cos_sub_clamped(sin_w, cos_w, self.sin_theta_o, self.cos_theta_o);
+        let sin_x = sin_sub_clamped(sin_w, cos_w, self.sin_theta_o, self.cos_theta_o);
         let cos_p = cos_sub_clamped(sin_x, cos_x, sin_b, cos_b);
         if cos_p <= self.cos_theta_e {
             return 0.0;
         }
-        let mut importance = self.intensity * cos_p / d2;
+        let mut importance = self.intensity * cos_p / d2c;
         if ctx.n != Vec3::ZERO {
             let cos_i = wi.dot(ctx.n).abs();
             let sin_i = safe_sqrt(1.0 - cos_i * cos_i);
@@ -110,18 +151,6 @@ impl LightBounds {
         }
         importance.max(0.0)
     }
-}
-
-/// cos of the half-angle of a cone from `p` that contains the box (through its bounding
-/// sphere); −1 (every direction) where `p` is inside that sphere.
-fn bound_subtended_cos(b: &Aabb, p: Vec3) -> f32 {
-    let c = b.center();
-    let r2 = (b.max - c).length_squared();
-    let d2 = p.distance_squared(c);
-    if d2 <= r2 {
-        return -1.0;
-    }
-    safe_sqrt(1.0 - r2 / d2)
 }
 
 /// The smallest cone (axis, cos half-angle) containing two cones (pbrt-v4 §3.8.4).

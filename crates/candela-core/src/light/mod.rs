@@ -15,7 +15,7 @@ mod point;
 mod sphere;
 mod triangle;
 
-pub use bounds::{cone_measure, cone_union, LightBounds};
+pub use bounds::{cone_measure, cone_union, ImportanceBounds, LightBounds};
 pub use point::PointLight;
 pub use sphere::SphereLight;
 pub use triangle::TriangleLight;

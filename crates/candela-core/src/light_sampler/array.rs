@@ -44,7 +44,7 @@ impl LightArray {
             .collect();
         let mut slots = Vec::with_capacity(counts.iter().map(|&c| c as usize).sum());
         for (i, &c) in counts.iter().enumerate() {
-            slots.extend(std::iter::repeat(i as u32).take(c as usize));
+            slots.extend(std::iter::repeat_n(i as u32, c as usize));
         }
         Some(LightArray { slots, counts })
     }

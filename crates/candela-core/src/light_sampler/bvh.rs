@@ -9,7 +9,7 @@
 
 use rayon::join;
 
-use crate::light::{cone_measure, Light, LightBounds, ShadingCtx};
+use crate::light::{cone_measure, ImportanceBounds, Light, LightBounds, ShadingCtx};
 use crate::sampling::ONE_MINUS_EPSILON;
 
 /// Buckets per split candidate of the build.
@@ -30,10 +30,19 @@ struct Node {
     is_leaf: bool,
 }
 
+/// A node as traversal reads it.
+#[derive(Clone, Copy, Debug)]
+struct FlatNode {
+    bounds: ImportanceBounds,
+    /// As in [`Node`].
+    index: u32,
+    is_leaf: bool,
+}
+
 /// A light BVH over the bounded lights, plus the unbounded ones.
 #[derive(Clone, Debug, Default)]
 pub struct LightBvh {
-    nodes: Vec<Node>,
+    nodes: Vec<FlatNode>,
     infinite: Vec<u32>,
     /// Per light: the branch taken at each level (bit d = level d, 1 = second child),
     /// with a leading 1 marking the depth; 0 where the light is not in the tree.
@@ -80,8 +89,17 @@ impl LightBvh {
                 index: 0,
                 is_leaf: true,
             };
-            bvh.nodes = vec![dummy; 2 * items.len() - 1];
-            build(&mut items, 0, &mut bvh.nodes, 0);
+            let mut nodes = vec![dummy; 2 * items.len() - 1];
+            build(&mut items, 0, &mut nodes, 0);
+            drop(items);
+            bvh.nodes = nodes
+                .iter()
+                .map(|n| FlatNode {
+                    bounds: ImportanceBounds::new(&n.bounds),
+                    index: n.index,
+                    is_leaf: n.is_leaf,
+                })
+                .collect();
             bvh.set_trails();
         }
         Some(bvh)
@@ -135,7 +153,7 @@ impl LightBvh {
             let (a, b) = (at + 1, node.index as usize);
             let ia = self.nodes[a].bounds.importance(ctx);
             let ib = self.nodes[b].bounds.importance(ctx);
-            if !(ia + ib > 0.0) {
+            if ia + ib <= 0.0 || (ia + ib).is_nan() {
                 return None;
             }
             let pa = ia / (ia + ib);
@@ -168,7 +186,7 @@ impl LightBvh {
             let (a, b) = (at + 1, node.index as usize);
             let ia = self.nodes[a].bounds.importance(ctx);
             let ib = self.nodes[b].bounds.importance(ctx);
-            if !(ia + ib > 0.0) {
+            if ia + ib <= 0.0 || (ia + ib).is_nan() {
                 return 0.0;
             }
             let pa = ia / (ia + ib);
@@ -188,7 +206,7 @@ impl LightBvh {
 
     /// Bytes held, for the benchmark's memory note.
     pub fn memory_bytes(&self) -> usize {
-        self.nodes.len() * std::mem::size_of::<Node>() + 8 * self.trails.len()
+        self.nodes.len() * std::mem::size_of::<FlatNode>() + 8 * self.trails.len()
     }
 
     pub fn node_count(&self) -> usize {
