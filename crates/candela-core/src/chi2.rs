@@ -49,10 +49,9 @@ pub struct ChiSquareTest {
     /// Significance of this one test (already Šidák-corrected by the caller, see
     /// [`sidak_alpha`]).
     pub alpha: f64,
-    /// Midpoint sub-samples per cell along each axis for integrating the density. A fine
-    /// grid rather than Simpson's rule, because the densities tested (cones, triangles)
-    /// are discontinuous, where higher-order rules gain nothing; at 32 the error of a
-    /// cell cut by a discontinuity is ~10⁻³ of its mass.
+    /// Midpoint points per side of each square of the adaptive integration of the density
+    /// (see `Quadrature`); a feature of the density smaller than 1/(2·k) of a cell may be
+    /// missed entirely.
     pub integration_res: usize,
     /// Samples allowed where the density is zero, as a fraction of all samples: samples
     /// exactly on the edge of a density's support may fall on either side in floating
@@ -67,7 +66,7 @@ impl Default for ChiSquareTest {
             sample_count: 1_000_000,
             seed: 0x5eed,
             alpha: 0.01,
-            integration_res: 32,
+            integration_res: 8,
             zero_pdf_tolerance: 1e-5,
         }
     }
@@ -186,7 +185,7 @@ impl ChiSquareTest {
             ));
         }
         let (dphi, dz) = (TAU / cols as f64, 2.0 / rows as f64);
-        let expected = self.integrate(cols, rows, |x, y| {
+        let expected = self.integrate(cols, rows, &observed, |x, y| {
             pdf(to_dir(x * dphi, -1.0 + y * dz)) as f64 * dphi * dz
         });
         let label = |i: usize| {
@@ -229,7 +228,7 @@ impl ChiSquareTest {
             Some((iy * cols + ix, pdf(p) == 0.0))
         });
         let (dx, dy) = (size.x / cols as f64, size.y / rows as f64);
-        let expected = self.integrate(cols, rows, |x, y| {
+        let expected = self.integrate(cols, rows, &observed, |x, y| {
             let p = Vec2::new(
                 (min.x as f64 + x * dx) as f32,
                 (min.y as f64 + y * dy) as f32,
@@ -275,23 +274,38 @@ impl ChiSquareTest {
         (observed, successes, zero_pdf)
     }
 
-    /// Expected counts: `density(x, y)` (in cell units, already times the cell's measure)
-    /// averaged over a midpoint grid in each cell, times the sample count.
-    fn integrate(&self, cols: usize, rows: usize, density: impl Fn(f64, f64) -> f64) -> Vec<f64> {
+    /// Expected counts: `density(x, y)` (at cell coordinates, already times the measure of
+    /// a unit cell) integrated over each cell adaptively, times the sample count.
+    ///
+    /// Cells that received samples are refined at least [`MIN_REFINE_SAMPLED`] levels
+    /// before the adaptive test may stop: near the poles of (φ, cos θ) a band of
+    /// directions a few degrees wide (a light seen edge-on) is a sliver thinner than the
+    /// coarse grid, which would otherwise find the density zero all over the cell.
+    fn integrate(
+        &self,
+        cols: usize,
+        rows: usize,
+        observed: &[f64],
+        density: impl Fn(f64, f64) -> f64,
+    ) -> Vec<f64> {
+        let n = self.sample_count as f64;
         let k = self.integration_res.max(1);
-        let scale = self.sample_count as f64 / (k * k) as f64;
         let mut expected = vec![0.0; cols * rows];
         for iy in 0..rows {
             for ix in 0..cols {
-                let mut sum = 0.0;
-                for sy in 0..k {
-                    for sx in 0..k {
-                        let x = ix as f64 + (sx as f64 + 0.5) / k as f64;
-                        let y = iy as f64 + (sy as f64 + 0.5) / k as f64;
-                        sum += density(x, y);
+                let (x, y) = (ix as f64, iy as f64);
+                let i = iy * cols + ix;
+                let coarse = midpoint(&density, x, y, 1.0, k);
+                let mut min_depth = if observed[i] > 0.0 { MIN_REFINE_SAMPLED } else { 0 };
+                expected[i] = loop {
+                    let q = Quadrature { k, n, min_depth };
+                    let e = n * q.adaptive(&density, x, y, 1.0, coarse, 0);
+                    // Samples but no density found: look closer before calling it zero.
+                    if e > 0.0 || observed[i] == 0.0 || min_depth >= MAX_FORCED_REFINE {
+                        break e;
                     }
-                }
-                expected[iy * cols + ix] = sum * scale;
+                    min_depth += 1;
+                };
             }
         }
         expected
@@ -313,7 +327,7 @@ impl ChiSquareTest {
         report.success_fraction = successes as f64 / n;
         report.zero_pdf_samples = zero_pdf;
         // The success fraction is binomial: 5 standard deviations of it, plus 10⁻³ for
-        // the integration error of the midpoint grid.
+        // the error of the adaptive integration (its relative tolerance per square).
         let f = report.success_fraction;
         let tol = 5.0 * (f * (1.0 - f) / n).sqrt() + 1e-3;
         if (report.pdf_integral - f).abs() > tol {
@@ -360,6 +374,76 @@ pub fn discrete(name: &str, counts: &[u64], pmf: &[f64], alpha: f64) -> Chi2Repo
             .push(format!("the pmf sums to {:.7}", report.pdf_integral));
     }
     report
+}
+
+/// Levels of refinement below a cell in [`adaptive`]: a discontinuity is resolved to
+/// 1/(k·2¹⁰) of a cell.
+const MAX_REFINE: u32 = 10;
+
+/// Midpoint rule with k×k points over the square of side `w` at (x, y).
+fn midpoint(density: &impl Fn(f64, f64) -> f64, x: f64, y: f64, w: f64, k: usize) -> f64 {
+    let h = w / k as f64;
+    let mut sum = 0.0;
+    for j in 0..k {
+        for i in 0..k {
+            sum += density(x + (i as f64 + 0.5) * h, y + (j as f64 + 0.5) * h);
+        }
+    }
+    sum * h * h
+}
+
+/// Refinement levels forced on a cell that received samples (see
+/// [`ChiSquareTest::integrate`]).
+const MIN_REFINE_SAMPLED: u32 = 2;
+
+/// Deepest uniform refinement tried on a cell that received samples where the density
+/// seemed zero everywhere (4⁶ squares of k² points).
+const MAX_FORCED_REFINE: u32 = 6;
+
+/// Adaptive midpoint quadrature over squares of cell coordinates.
+struct Quadrature {
+    /// Points per side of a square.
+    k: usize,
+    /// Samples in all, to express tolerances in expected samples.
+    n: f64,
+    min_depth: u32,
+}
+
+impl Quadrature {
+    /// Compares the square's estimate `coarse` with the sum over its four quadrants and
+    /// recurses where they differ by more than 10⁻³ of the value or 10⁻² of an expected
+    /// sample. The densities tested are discontinuous (cones, triangles) and steep near a
+    /// light's horizon, where a fixed grid is off by more than the noise of 10⁶ samples.
+    #[allow(clippy::too_many_arguments)]
+    fn adaptive(
+        &self,
+        density: &impl Fn(f64, f64) -> f64,
+        x: f64,
+        y: f64,
+        w: f64,
+        coarse: f64,
+        depth: u32,
+    ) -> f64 {
+        let (k, n) = (self.k, self.n);
+        let h = 0.5 * w;
+        let quads = [(x, y), (x + h, y), (x, y + h), (x + h, y + h)];
+        let fine = quads.map(|(qx, qy)| midpoint(density, qx, qy, h, k));
+        let sum: f64 = fine.iter().sum();
+        // The coarse estimate passed down was taken on a grid nested in the fine one; they
+        // can agree by coincidence at a discontinuity. A second coarse estimate on a grid
+        // of k−1 points per side does not nest with it.
+        let coarse_odd = midpoint(density, x, y, w, k.saturating_sub(1).max(1));
+        let err = (sum - coarse).abs().max((sum - coarse_odd).abs()) * n;
+        let converged = depth >= self.min_depth && err <= (1e-3 * sum.abs() * n).max(1e-2);
+        if depth >= MAX_REFINE || converged {
+            return sum;
+        }
+        quads
+            .iter()
+            .zip(fine)
+            .map(|(&(qx, qy), c)| self.adaptive(density, qx, qy, h, c, depth + 1))
+            .sum()
+    }
 }
 
 /// Pools small cells, computes χ² and its p-value, and lists the worst cells.

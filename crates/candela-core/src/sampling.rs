@@ -136,7 +136,10 @@ impl AliasTable {
             .collect();
         let (mut small, mut large): (Vec<usize>, Vec<usize>) =
             (0..n).partition(|&i| scaled[i] < 1.0);
-        while let (Some(s), Some(&l)) = (small.pop(), large.last()) {
+        // Peek at both lists before taking from either: popping `small` first would lose
+        // its last entry (with q = 0) whenever round-off empties `large` first.
+        while let (Some(&s), Some(&l)) = (small.last(), large.last()) {
+            small.pop();
             bins[s].q = scaled[s] as f32;
             bins[s].alias = l as u32;
             scaled[l] -= 1.0 - scaled[s];
