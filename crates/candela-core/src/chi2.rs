@@ -180,9 +180,7 @@ impl ChiSquareTest {
             Some((iy * cols + ix, pdf(d) == 0.0))
         });
         if non_unit > 0 {
-            extra.push(format!(
-                "{non_unit} samples were not finite unit vectors"
-            ));
+            extra.push(format!("{non_unit} samples were not finite unit vectors"));
         }
         let (dphi, dz) = (TAU / cols as f64, 2.0 / rows as f64);
         let expected = self.integrate(cols, rows, &observed, |x, y| {
@@ -296,7 +294,11 @@ impl ChiSquareTest {
                 let (x, y) = (ix as f64, iy as f64);
                 let i = iy * cols + ix;
                 let coarse = midpoint(&density, x, y, 1.0, k);
-                let mut min_depth = if observed[i] > 0.0 { MIN_REFINE_SAMPLED } else { 0 };
+                let mut min_depth = if observed[i] > 0.0 {
+                    MIN_REFINE_SAMPLED
+                } else {
+                    0
+                };
                 expected[i] = loop {
                     let q = Quadrature { k, n, min_depth };
                     let e = n * q.adaptive(&density, x, y, 1.0, coarse, 0);
@@ -337,9 +339,9 @@ impl ChiSquareTest {
             ));
         }
         if zero_pdf as f64 > self.zero_pdf_tolerance * n {
-            report.failures.push(format!(
-                "{zero_pdf} samples landed where the pdf is 0"
-            ));
+            report
+                .failures
+                .push(format!("{zero_pdf} samples landed where the pdf is 0"));
         }
         report
     }

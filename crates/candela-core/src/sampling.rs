@@ -3,7 +3,7 @@
 //! Every `sample_*` maps uniform `u ∈ [0,1)²` to a point of its domain; the matching
 //! `*_pdf` gives the density of that warp with respect to the domain's natural measure
 //! (solid angle for directions, area for points). Each warp is checked by the chi-square
-//! suite in `tests/chi2_warps.rs`.
+//! suite in `tests/chi2_sampling.rs`.
 
 use std::f32::consts::{FRAC_PI_2, FRAC_PI_4, PI};
 

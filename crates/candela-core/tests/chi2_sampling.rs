@@ -11,8 +11,8 @@ use candela_core::light::{Light, ShadingCtx, SphereLight, TriangleLight};
 use candela_core::math::Frame;
 use candela_core::sampler::Pcg32;
 use candela_core::sampling::{
-    cosine_hemisphere_pdf, sample_cosine_hemisphere, sample_uniform_cone,
-    sample_uniform_sphere, uniform_cone_pdf, AliasTable, UNIFORM_SPHERE_PDF,
+    cosine_hemisphere_pdf, sample_cosine_hemisphere, sample_uniform_cone, sample_uniform_sphere,
+    uniform_cone_pdf, AliasTable, UNIFORM_SPHERE_PDF,
 };
 use glam::{Vec2, Vec3};
 
@@ -29,18 +29,22 @@ fn test() -> ChiSquareTest {
 #[test]
 fn cosine_hemisphere() {
     test()
-        .spherical("cosine hemisphere", |u| Some(sample_cosine_hemisphere(u)), |d| {
-            cosine_hemisphere_pdf(d.z)
-        })
+        .spherical(
+            "cosine hemisphere",
+            |u| Some(sample_cosine_hemisphere(u)),
+            |d| cosine_hemisphere_pdf(d.z),
+        )
         .assert_passed();
 }
 
 #[test]
 fn uniform_sphere() {
     test()
-        .spherical("uniform sphere", |u| Some(sample_uniform_sphere(u)), |_| {
-            UNIFORM_SPHERE_PDF
-        })
+        .spherical(
+            "uniform sphere",
+            |u| Some(sample_uniform_sphere(u)),
+            |_| UNIFORM_SPHERE_PDF,
+        )
         .assert_passed();
 }
 
@@ -51,7 +55,13 @@ fn uniform_cones() {
             .spherical(
                 &format!("uniform cone, cos θmax = {cos_max}"),
                 |u| Some(sample_uniform_cone(u, cos_max)),
-                |d| if d.z >= cos_max { uniform_cone_pdf(cos_max) } else { 0.0 },
+                |d| {
+                    if d.z >= cos_max {
+                        uniform_cone_pdf(cos_max)
+                    } else {
+                        0.0
+                    }
+                },
             )
             .assert_passed();
     }
@@ -118,7 +128,11 @@ fn sphere_light_from_inside_samples_its_area() {
         light_test(&format!("inward sphere light seen from {p}"), &light, p).assert_passed();
     }
     let outward = sphere(Vec3::ZERO, 1.0, false);
-    let r = light_test("outward sphere light seen from inside", &outward, Vec3::new(0.3, 0.0, 0.0));
+    let r = light_test(
+        "outward sphere light seen from inside",
+        &outward,
+        Vec3::new(0.3, 0.0, 0.0),
+    );
     r.assert_passed();
     assert_eq!(r.success_fraction, 0.0);
 }
@@ -154,7 +168,10 @@ fn diffuse_bsdf() {
     let lobe = Diffuse {
         albedo: Vec3::splat(0.5),
     };
-    for wo in [Vec3::new(0.3, -0.2, 0.8).normalize(), Vec3::new(0.1, 0.5, -0.4).normalize()] {
+    for wo in [
+        Vec3::new(0.3, -0.2, 0.8).normalize(),
+        Vec3::new(0.1, 0.5, -0.4).normalize(),
+    ] {
         test()
             .spherical(
                 &format!("diffuse lobe, wo = {wo}"),

@@ -7,8 +7,8 @@ use glam::Vec2;
 
 use super::*;
 use crate::sampling::{
-    cosine_hemisphere_pdf, sample_concentric_disk, sample_cosine_hemisphere,
-    sample_uniform_sphere, UNIFORM_SPHERE_PDF,
+    cosine_hemisphere_pdf, sample_concentric_disk, sample_cosine_hemisphere, sample_uniform_sphere,
+    UNIFORM_SPHERE_PDF,
 };
 
 fn small() -> ChiSquareTest {
@@ -27,7 +27,10 @@ fn ln_gamma_matches_factorials_and_sqrt_pi() {
     assert!(close(ln_gamma(1.0), 0.0));
     assert!(close(ln_gamma(5.0), 24f64.ln()));
     assert!(close(ln_gamma(0.5), std::f64::consts::PI.sqrt().ln()));
-    assert!(close(ln_gamma(101.0), (1..=100).map(|i| (i as f64).ln()).sum()));
+    assert!(close(
+        ln_gamma(101.0),
+        (1..=100).map(|i| (i as f64).ln()).sum()
+    ));
 }
 
 #[test]
@@ -35,7 +38,10 @@ fn chi2_survival_matches_closed_forms_and_tables() {
     // Two degrees of freedom: Q = e^{-x/2} exactly.
     for x in [0.1, 1.0, 5.0, 30.0, 200.0] {
         let q = chi2_survival(x, 2.0);
-        assert!((q / (-x / 2.0f64).exp() - 1.0).abs() < 1e-10, "x = {x}: {q}");
+        assert!(
+            (q / (-x / 2.0f64).exp() - 1.0).abs() < 1e-10,
+            "x = {x}: {q}"
+        );
     }
     // Upper 5% and 1% points from standard tables (Abramowitz & Stegun 26.8).
     for (x, k, p) in [
@@ -46,7 +52,10 @@ fn chi2_survival_matches_closed_forms_and_tables() {
         (1_106.969_0, 1000.0, 0.01),
     ] {
         let q = chi2_survival(x, k);
-        assert!((q - p).abs() < 1e-4 * p.max(0.01) * 10.0, "k = {k}: {q} vs {p}");
+        assert!(
+            (q - p).abs() < 1e-4 * p.max(0.01) * 10.0,
+            "k = {k}: {q} vs {p}"
+        );
     }
     assert_eq!(chi2_survival(0.0, 3.0), 1.0);
     assert!(chi2_survival(1e4, 3.0) < 1e-300);
@@ -61,9 +70,11 @@ fn sidak_alpha_composes_to_the_family_significance() {
 
 #[test]
 fn accepts_a_correct_direction_sampler() {
-    let r = small().spherical("cosine", |u| Some(sample_cosine_hemisphere(u)), |d| {
-        cosine_hemisphere_pdf(d.z)
-    });
+    let r = small().spherical(
+        "cosine",
+        |u| Some(sample_cosine_hemisphere(u)),
+        |d| cosine_hemisphere_pdf(d.z),
+    );
     r.assert_passed();
     assert!((r.pdf_integral - 1.0).abs() < 1e-3, "{r}");
 }
@@ -71,13 +82,17 @@ fn accepts_a_correct_direction_sampler() {
 #[test]
 fn rejects_cosine_samples_against_a_uniform_hemisphere_pdf() {
     // Same support and both normalized: only the histogram's shape can tell them apart.
-    let r = small().spherical("cosine vs uniform", |u| Some(sample_cosine_hemisphere(u)), |d| {
-        if d.z > 0.0 {
-            1.0 / (2.0 * PI)
-        } else {
-            0.0
-        }
-    });
+    let r = small().spherical(
+        "cosine vs uniform",
+        |u| Some(sample_cosine_hemisphere(u)),
+        |d| {
+            if d.z > 0.0 {
+                1.0 / (2.0 * PI)
+            } else {
+                0.0
+            }
+        },
+    );
     assert!(!r.passed(), "{r}");
     assert!(r.p_value < 1e-100, "{r}");
     assert!(r.failures.iter().any(|f| f.contains("histogram")), "{r}");
@@ -89,9 +104,11 @@ fn rejects_cosine_samples_against_a_uniform_hemisphere_pdf() {
 fn rejects_a_pdf_off_by_a_constant() {
     // The shape is right, so χ² alone would pass the normalized counts: the integral check
     // must catch it.
-    let r = small().spherical("sphere, pdf × 1.01", |u| Some(sample_uniform_sphere(u)), |_| {
-        UNIFORM_SPHERE_PDF * 1.01
-    });
+    let r = small().spherical(
+        "sphere, pdf × 1.01",
+        |u| Some(sample_uniform_sphere(u)),
+        |_| UNIFORM_SPHERE_PDF * 1.01,
+    );
     assert!(r.failures.iter().any(|f| f.contains("integrates")), "{r}");
 }
 
@@ -110,37 +127,59 @@ fn accounts_for_failed_samples() {
 #[test]
 fn rejects_samples_where_the_pdf_is_zero() {
     // Uniform-sphere samples, but the pdf claims they never go below z = -0.9.
-    let r = small().spherical("leaky", |u| Some(sample_uniform_sphere(u)), |d| {
-        if d.z > -0.9 {
-            UNIFORM_SPHERE_PDF
-        } else {
-            0.0
-        }
-    });
+    let r = small().spherical(
+        "leaky",
+        |u| Some(sample_uniform_sphere(u)),
+        |d| {
+            if d.z > -0.9 {
+                UNIFORM_SPHERE_PDF
+            } else {
+                0.0
+            }
+        },
+    );
     assert!(r.failures.iter().any(|f| f.contains("pdf is 0")), "{r}");
 }
 
 #[test]
 fn rejects_non_unit_directions() {
-    let r = small().spherical("long", |u| Some(2.0 * sample_uniform_sphere(u)), |_| {
-        UNIFORM_SPHERE_PDF
-    });
+    let r = small().spherical(
+        "long",
+        |u| Some(2.0 * sample_uniform_sphere(u)),
+        |_| UNIFORM_SPHERE_PDF,
+    );
     assert!(r.failures.iter().any(|f| f.contains("unit")), "{r}");
 }
 
 #[test]
 fn planar_accepts_the_concentric_disk_and_rejects_a_naive_polar_map() {
-    let disk_pdf = |p: Vec2| if p.length_squared() <= 1.0 { 1.0 / PI } else { 0.0 };
+    let disk_pdf = |p: Vec2| {
+        if p.length_squared() <= 1.0 {
+            1.0 / PI
+        } else {
+            0.0
+        }
+    };
     let t = small();
-    let ok = t.planar("concentric disk", -Vec2::ONE, Vec2::ONE, |u| {
-        Some(sample_concentric_disk(u))
-    }, disk_pdf);
+    let ok = t.planar(
+        "concentric disk",
+        -Vec2::ONE,
+        Vec2::ONE,
+        |u| Some(sample_concentric_disk(u)),
+        disk_pdf,
+    );
     ok.assert_passed();
     // r = u₁ instead of √u₁ crowds the centre: the classic mistake.
-    let bad = t.planar("naive polar disk", -Vec2::ONE, Vec2::ONE, |u| {
-        let (s, c) = (2.0 * PI * u.y).sin_cos();
-        Some(u.x * Vec2::new(c, s))
-    }, disk_pdf);
+    let bad = t.planar(
+        "naive polar disk",
+        -Vec2::ONE,
+        Vec2::ONE,
+        |u| {
+            let (s, c) = (2.0 * PI * u.y).sin_cos();
+            Some(u.x * Vec2::new(c, s))
+        },
+        disk_pdf,
+    );
     assert!(!bad.passed(), "{bad}");
     assert!(bad.histogram_dump().lines().count() == 2 * (t.res + 1));
 }
@@ -152,7 +191,13 @@ fn discrete_accepts_true_frequencies_and_rejects_a_wrong_pmf() {
     let mut counts = [0u64; 4];
     for _ in 0..100_000 {
         let u = rng.uniform_f32() as f64;
-        let i = if u < 0.1 { 0 } else if u < 0.4 { 2 } else { 3 };
+        let i = if u < 0.1 {
+            0
+        } else if u < 0.4 {
+            2
+        } else {
+            3
+        };
         counts[i] += 1;
     }
     discrete("true", &counts, &pmf, 0.01).assert_passed();
@@ -160,5 +205,8 @@ fn discrete_accepts_true_frequencies_and_rejects_a_wrong_pmf() {
     assert!(!discrete("wrong", &counts, &wrong, 0.01).passed());
     counts[1] = 1;
     let r = discrete("impossible outcome", &counts, &pmf, 0.01);
-    assert!(r.failures.iter().any(|f| f.contains("probability 0")), "{r}");
+    assert!(
+        r.failures.iter().any(|f| f.contains("probability 0")),
+        "{r}"
+    );
 }
