@@ -31,6 +31,7 @@ pub mod bsdf;
 pub mod build;
 pub mod bvh;
 pub mod camera;
+pub mod chi2;
 pub mod color;
 pub mod desc;
 pub mod film;
