@@ -6,6 +6,8 @@ use std::path::Path;
 
 use candela_core::desc::{SceneDesc, Span};
 
+pub mod ies;
+
 /// A file that could not be loaded, with where and why. Displays as
 /// `file:line:col: message`.
 #[derive(Clone, Debug, PartialEq, Eq)]
