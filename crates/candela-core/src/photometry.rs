@@ -284,7 +284,7 @@ impl GoniometricTable {
             let mut k = peak_k as i64;
             loop {
                 let next = k + dir;
-                if next < 0 || next > 2 * STEPS {
+                if !(0..=2 * STEPS).contains(&next) {
                     return None;
                 }
                 let (a, b) = (samples[k as usize], samples[next as usize]);

@@ -221,3 +221,31 @@ fn direction(theta_deg: f64, phi_deg: f64) -> glam::Vec3 {
         t.cos() as f32,
     )
 }
+
+#[test]
+fn polar_plot_draws_both_planes_within_the_peak_ring() {
+    let Some(dir) = data_dir() else { return };
+    for f in ies_files(&dir) {
+        let ies = load_ies(&f).unwrap_or_else(|e| panic!("{e}"));
+        let img = candela_scene::ies::polar_plot(&ies, 256).unwrap();
+        assert_eq!(img.dimensions(), (256, 256));
+        let (c, r) = (128.0f64, 0.45 * 256.0);
+        let mut coloured = [0usize; 2];
+        for (x, y, p) in img.enumerate_pixels() {
+            let k = match p.0 {
+                [210, 30, 30] => 0,
+                [30, 60, 210] => 1,
+                _ => continue,
+            };
+            coloured[k] += 1;
+            // Curves are scaled to the peak: nothing outside the 100% ring (+2 px pen).
+            let d = ((x as f64 + 0.5 - c).powi(2) + (y as f64 + 0.5 - c).powi(2)).sqrt();
+            assert!(d <= r + 2.5, "{}: pixel at distance {d}", f.display());
+        }
+        assert!(
+            coloured[0] > 50 || coloured[1] > 50,
+            "{}: {coloured:?}",
+            f.display()
+        );
+    }
+}

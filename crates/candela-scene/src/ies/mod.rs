@@ -133,7 +133,7 @@ impl IesFile {
 
     /// Total rated lamp lumens (lamps × lumens per lamp); `None` for absolute photometry.
     pub fn stated_lumens(&self) -> Option<f64> {
-        (self.lumens_per_lamp > 0.0).then(|| self.lumens_per_lamp * self.lamp_count as f64)
+        (self.lumens_per_lamp > 0.0).then_some(self.lumens_per_lamp * self.lamp_count as f64)
     }
 
     /// The luminous opening in metres.
