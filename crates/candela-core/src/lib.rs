@@ -41,6 +41,7 @@ pub mod light;
 pub mod light_sampler;
 pub mod material;
 pub mod math;
+pub mod photometry;
 pub mod sampler;
 pub mod sampling;
 pub mod scene;
