@@ -1,11 +1,11 @@
 //! Light selection: every sampler's pmf sums to one and matches the frequencies of its
 //! picks (chi-square), and RIS's weight is unbiased per light (z-tests).
 //!
-//! The chi-square here is a compact local one (`candela_core::chi2` had not landed when
-//! this was written): bins with expected count < 5 are pooled, and the critical value
-//! comes from the Wilson–Hilferty approximation of the χ² quantile, accurate to ~1% for
-//! the 20+ degrees of freedom used here.
+//! The chi-square is `candela_core::chi2::discrete` (cells with fewer than 5 expected
+//! picks pooled, p-value from the incomplete gamma function; it also fails on any pick of
+//! a probability-0 light and on a pmf that does not sum to one).
 
+use candela_core::chi2::{discrete, sidak_alpha};
 use candela_core::desc::LightSamplerKind;
 use candela_core::light::{Light, LightId, PointLight, ShadingCtx, SphereLight, TriangleLight};
 use candela_core::light_sampler::LightSampler;
@@ -65,58 +65,25 @@ fn contexts() -> [ShadingCtx; 4] {
     ]
 }
 
-/// Upper α-quantile of χ² with k degrees of freedom (Wilson & Hilferty 1931), for the
-/// standard normal quantile `z` of α.
-fn chi2_critical(k: f64, z: f64) -> f64 {
-    let a = 2.0 / (9.0 * k);
-    k * (1.0 - a + z * a.sqrt()).powi(3)
-}
-
-/// Pearson's statistic of `observed` against `expected` counts with small bins pooled;
-/// returns (statistic, degrees of freedom).
-fn chi2_statistic(observed: &[u64], expected: &[f64]) -> (f64, f64) {
-    let mut stat = 0.0;
-    let mut bins = 0;
-    let (mut pool_o, mut pool_e) = (0.0, 0.0);
-    for (&o, &e) in observed.iter().zip(expected) {
-        if e < 5.0 {
-            pool_o += o as f64;
-            pool_e += e;
-        } else {
-            stat += (o as f64 - e).powi(2) / e;
-            bins += 1;
-        }
-    }
-    if pool_e > 0.0 {
-        stat += (pool_o - pool_e).powi(2) / pool_e.max(1e-9);
-        bins += 1;
-    }
-    (stat, (bins - 1) as f64)
-}
-
 const SAMPLES: usize = 200_000;
 
 #[test]
 fn pmfs_sum_to_one_and_match_pick_frequencies() {
     let lights = lights();
-    // α = 10⁻⁴ per test (z = 3.719), 20 tests: family-wise false alarm rate 0.2%.
-    let z_alpha = 3.719;
-    for kind in [
+    let kinds = [
         LightSamplerKind::Uniform,
         LightSamplerKind::Power,
         LightSamplerKind::Array,
         LightSamplerKind::Bvh,
-    ] {
+    ];
+    // 16 tests; Šidák-corrected so that the suite falsely fails with probability 1%.
+    let alpha = sidak_alpha(0.01, kinds.len() * contexts().len());
+    for kind in kinds {
         let sampler = LightSampler::new(kind, 8, &lights);
         for (ci, ctx) in contexts().iter().enumerate() {
             let pmf: Vec<f64> = (0..lights.len() as u32)
                 .map(|i| sampler.pmf(ctx, LightId(i)) as f64)
                 .collect();
-            let total: f64 = pmf.iter().sum();
-            assert!(
-                (total - 1.0).abs() < 1e-4,
-                "{kind:?} ctx {ci}: Σpmf = {total}"
-            );
             let mut counts = vec![0u64; lights.len()];
             let mut rng = Pcg32::new(11, ci as u64);
             for _ in 0..SAMPLES {
@@ -129,19 +96,34 @@ fn pmfs_sum_to_one_and_match_pick_frequencies() {
                 assert_eq!(pick.pmf, pick.mis_pmf);
                 counts[i] += 1;
             }
-            for (i, (&c, &p)) in counts.iter().zip(&pmf).enumerate() {
-                assert!(p > 0.0 || c == 0, "{kind:?}: light {i} picked at pmf 0");
-            }
-            let expected: Vec<f64> = pmf.iter().map(|p| p * SAMPLES as f64).collect();
-            let (stat, dof) = chi2_statistic(&counts, &expected);
-            let crit = chi2_critical(dof, z_alpha);
-            eprintln!("{kind:?} ctx {ci}: χ² = {stat:.1}, dof {dof}, critical {crit:.1}");
-            assert!(
-                stat < crit,
-                "{kind:?} ctx {ci}: χ² = {stat} ≥ {crit} (dof {dof})"
+            let report = discrete(&format!("{kind:?} at ctx {ci}"), &counts, &pmf, alpha);
+            eprintln!(
+                "{kind:?} ctx {ci}: χ² = {:.1}, dof {}, p = {:.3}",
+                report.statistic, report.dof, report.p_value
             );
+            report.assert_passed();
         }
     }
+}
+
+/// The check above has teeth: the BVH's picks at one point tested against its pmf at
+/// another point (a plausible bug: a stale shading context) fail.
+#[test]
+fn chi_square_catches_a_pmf_from_the_wrong_point() {
+    let lights = lights();
+    let sampler = LightSampler::new(LightSamplerKind::Bvh, 8, &lights);
+    let [a, b, ..] = contexts();
+    let pmf: Vec<f64> = (0..lights.len() as u32)
+        .map(|i| sampler.pmf(&b, LightId(i)) as f64)
+        .collect();
+    let mut counts = vec![0u64; lights.len()];
+    let mut rng = Pcg32::new(17, 0);
+    for _ in 0..SAMPLES {
+        if let Some(pick) = sampler.sample(&a, rng.uniform_f32(), &lights) {
+            counts[pick.id.0 as usize] += 1;
+        }
+    }
+    assert!(!discrete("wrong point", &counts, &pmf, 0.01).passed());
 }
 
 #[test]
