@@ -225,3 +225,32 @@ fn ris_weight_is_unbiased_for_every_light() {
         }
     }
 }
+
+/// Where a light's importance (the RIS target) is zero, its samples must carry nothing a
+/// BSDF could scatter: no direction with radiance and a non-zero receiver cosine.
+#[test]
+fn zero_importance_means_no_contribution() {
+    let lights = lights();
+    let mut rng = Pcg32::new(23, 0);
+    let mut zeros = 0;
+    for _ in 0..200 {
+        let p = Vec3::new(rng.uniform_f32(), rng.uniform_f32(), rng.uniform_f32()) * 10.0
+            - Vec3::new(5.0, 3.0, 5.0);
+        let ctx = ShadingCtx { p, n: Vec3::Y };
+        for l in &lights {
+            if l.importance(&ctx) > 0.0 {
+                continue;
+            }
+            zeros += 1;
+            for _ in 0..64 {
+                let u = glam::Vec2::new(rng.uniform_f32(), rng.uniform_f32());
+                if let Some(s) = l.sample_li(&ctx, u) {
+                    let c = s.radiance * s.wi.dot(ctx.n).abs();
+                    assert_eq!(c, Vec3::ZERO, "{l:?} at {p}: zero importance, sample {s:?}");
+                }
+            }
+        }
+    }
+    // The check is not vacuous: about half the triangles face away from any point.
+    assert!(zeros > 1000, "only {zeros} zero-importance cases");
+}
