@@ -155,7 +155,33 @@ fn array_rounding_leaves_no_emitting_light_without_slots() {
     let total: f64 = (0..100).map(|i| a.pmf(i) as f64).sum();
     assert!((total - 1.0).abs() < 1e-5);
     assert!((2..100).all(|i| a.pmf(i) > 0.0));
-    assert!(a.len() >= 400 - 1 && a.len() <= 400 + 100);
+    // M is the power of two at or above 4N, and every slot is accounted for.
+    assert_eq!(a.len(), 512);
+    let slots: f64 = (0..100).map(|i| a.pmf(i) as f64 * 512.0).sum();
+    assert_eq!(slots.round() as usize, 512);
+    // The faint lights hold exactly one slot each: the one they are guaranteed.
+    assert!((2..100).all(|i| a.pmf(i) == 1.0 / 512.0));
+}
+
+/// With M a power of two, the 2²⁴ values an `f32` uniform takes hit every slot equally
+/// often: picks follow the pmf exactly, with no quantization bias.
+#[test]
+fn array_picks_are_exact_over_all_f32_uniforms() {
+    use candela_core::light_sampler::LightArray;
+    let powers: Vec<f32> = (0..300).map(|i| 1.0 + (i * 37 % 101) as f32).collect();
+    let a = LightArray::new(&powers).unwrap();
+    let mut counts = vec![0u64; powers.len()];
+    for j in 0..1u32 << 24 {
+        let (i, _) = a.sample(j as f32 / (1u32 << 24) as f32);
+        counts[i as usize] += 1;
+    }
+    for (i, &c) in counts.iter().enumerate() {
+        assert_eq!(
+            c as f64,
+            a.pmf(i as u32) as f64 * (1u64 << 24) as f64,
+            "light {i}"
+        );
+    }
 }
 
 /// RIS picks are not described by a tractable pmf; what must hold is that for every

@@ -4,15 +4,21 @@
 
 use crate::sampling::ONE_MINUS_EPSILON;
 
-/// Slots per light on average; more slots follow the powers more closely.
-const SLOTS_PER_LIGHT: f64 = 4.0;
+/// Slots per light on average, at least; more slots follow the powers more closely.
+const SLOTS_PER_LIGHT: usize = 4;
 
 /// A slot array over lights.
 ///
-/// Rounding: a light of power Φᵢ > 0 gets sᵢ = max(1, round(4N · Φᵢ / ΣΦ)) slots, so no
-/// light that emits is left without a slot (a faint light is over-sampled by at most one
-/// slot's worth); a light of zero power gets none. M = Σ sᵢ, and the pick probability
-/// sᵢ / M is exact, not the rounded-away Φᵢ / ΣΦ.
+/// Size: M is the power of two at or above 4N. A slot is chosen from the 24 random bits of
+/// one `f32` as ⌊u·M⌋, which hits every slot equally often only when M divides 2²⁴, so the
+/// pick probabilities are exact for up to 2²² lights (beyond that, slots differ by one
+/// part in 2²⁴/M).
+///
+/// Rounding: each light of power Φᵢ > 0 gets one slot, plus ⌊R·Φᵢ/ΣΦ⌋ of the R = M − n₊
+/// remaining ones (n₊ the lights with power); the few slots this leaves over go one each
+/// to the largest remainders. So no light that emits is left without a slot (a faint
+/// light is over-sampled by at most one slot's worth), a light of zero power gets none,
+/// Σ sᵢ = M, and the pick probability sᵢ/M is exact, not the rounded-away Φᵢ/ΣΦ.
 #[derive(Clone, Debug)]
 pub struct LightArray {
     slots: Vec<u32>,
@@ -28,24 +34,36 @@ impl LightArray {
             return None;
         }
         let total: f64 = powers.iter().map(|&p| p as f64).sum();
-        if total <= 0.0 {
+        let emitting = powers.iter().filter(|&&p| p > 0.0).count();
+        if total <= 0.0 || emitting == 0 {
             return None;
         }
-        let target = SLOTS_PER_LIGHT * powers.len() as f64;
-        let counts: Vec<u32> = powers
-            .iter()
-            .map(|&p| {
-                if p > 0.0 {
-                    ((p as f64 / total * target).round() as u32).max(1)
-                } else {
-                    0
-                }
-            })
-            .collect();
-        let mut slots = Vec::with_capacity(counts.iter().map(|&c| c as usize).sum());
+        let m = (SLOTS_PER_LIGHT * powers.len()).next_power_of_two();
+        let rest = (m - emitting) as f64;
+        let mut counts = vec![0u32; powers.len()];
+        let mut remainders = Vec::with_capacity(emitting);
+        let mut used = 0usize;
+        for (i, &p) in powers.iter().enumerate() {
+            if p > 0.0 {
+                let share = rest * p as f64 / total;
+                counts[i] = 1 + share as u32;
+                used += counts[i] as usize;
+                remainders.push((share.fract(), i as u32));
+            }
+        }
+        // Round-off in the shares can only leave slots over, never take too many.
+        let left = m.saturating_sub(used).min(remainders.len());
+        if left > 0 {
+            remainders.select_nth_unstable_by(left - 1, |a, b| b.0.total_cmp(&a.0));
+            for &(_, i) in &remainders[..left] {
+                counts[i as usize] += 1;
+            }
+        }
+        let mut slots = Vec::with_capacity(m);
         for (i, &c) in counts.iter().enumerate() {
             slots.extend(std::iter::repeat_n(i as u32, c as usize));
         }
+        // Should round-off leave the sum off by a slot, M is what the slots say.
         Some(LightArray { slots, counts })
     }
 
@@ -61,6 +79,7 @@ impl LightArray {
     /// A light and its probability, from one uniform number.
     pub fn sample(&self, u: f32) -> (u32, f32) {
         let m = self.slots.len();
+        // Exact for u = j/2²⁴ when M is a power of two ≤ 2²⁴: slot j·M/2²⁴.
         let k = ((u.min(ONE_MINUS_EPSILON) as f64 * m as f64) as usize).min(m - 1);
         let i = self.slots[k];
         (i, self.pmf(i))
