@@ -75,20 +75,22 @@ struct Bokeh {
 /// Renders a tiny emitter at depth `z` on the view axis through an aperture focused at
 /// `focus`, and measures its bokeh.
 fn measure_bokeh(aperture: ApertureDesc, radius: f32, focus: f32, z: f32, res: u32) -> Bokeh {
-    let mut desc = SceneDesc::default();
-    desc.render = RenderSettings {
-        width: res,
-        height: res,
-        spp: 1024,
-        max_depth: 0,
-        seed: 3,
+    let mut desc = SceneDesc {
+        render: RenderSettings {
+            width: res,
+            height: res,
+            spp: 1024,
+            max_depth: 0,
+            seed: 3,
+            ..Default::default()
+        },
+        camera: camera(Some(LensDesc {
+            focus: FocusDesc::Distance(focus),
+            size: ApertureSizeDesc::Radius(radius),
+            aperture,
+        })),
         ..Default::default()
     };
-    desc.camera = camera(Some(LensDesc {
-        focus: FocusDesc::Distance(focus),
-        size: ApertureSizeDesc::Radius(radius),
-        aperture,
-    }));
     desc.materials.push(black_material());
     // The emitter's own image is ~3 px in radius: small beside the bokeh, large enough
     // that 1024 samples per pixel see it often.
@@ -265,16 +267,18 @@ fn disc_bokeh_has_no_corners() {
 /// A scene that lies in the plane z = −3: a lit diffuse backdrop and two tilted emissive
 /// squares (their edges cut pixels, so pixels vary within themselves).
 fn flat_scene(lens: Option<LensDesc>, seed: u64) -> SceneDesc {
-    let mut desc = SceneDesc::default();
-    desc.render = RenderSettings {
-        width: 24,
-        height: 24,
-        spp: 1,
-        max_depth: 1,
-        seed,
+    let mut desc = SceneDesc {
+        render: RenderSettings {
+            width: 24,
+            height: 24,
+            spp: 1,
+            max_depth: 1,
+            seed,
+            ..Default::default()
+        },
+        camera: camera(lens),
         ..Default::default()
     };
-    desc.camera = camera(lens);
     desc.materials.push(black_material());
     desc.materials.push(MaterialDesc {
         name: "grey".into(),

@@ -153,7 +153,8 @@ fn pinhole_ignores_the_lens_sample_and_zero_aperture_is_a_pinhole() {
 #[test]
 fn bad_lens_descriptions_are_errors_with_their_span() {
     let span = Span::new("dof.toml", 7, 1);
-    let cases: Vec<(Box<dyn Fn(&mut CameraDesc)>, &str)> = vec![
+    type Edit = Box<dyn Fn(&mut CameraDesc)>;
+    let cases: Vec<(Edit, &str)> = vec![
         (
             Box::new(|c| c.lens.as_mut().unwrap().focus = FocusDesc::Distance(-1.0)),
             "focus distance",
@@ -205,12 +206,14 @@ fn bad_lens_descriptions_are_errors_with_their_span() {
         (Box::new(|c| c.sensor_mm = Vec2::new(36.0, -1.0)), "sensor"),
     ];
     for (edit, what) in cases {
-        let mut desc = SceneDesc::default();
-        desc.camera = CameraDesc {
-            position: Vec3::new(0.0, 0.0, 5.0),
-            look_at: Vec3::ZERO,
-            span: span.clone(),
-            ..lens_camera(2.0, ApertureDesc::Disc)
+        let mut desc = SceneDesc {
+            camera: CameraDesc {
+                position: Vec3::new(0.0, 0.0, 5.0),
+                look_at: Vec3::ZERO,
+                span: span.clone(),
+                ..lens_camera(2.0, ApertureDesc::Disc)
+            },
+            ..Default::default()
         };
         edit(&mut desc.camera);
         let e = build(&desc)
