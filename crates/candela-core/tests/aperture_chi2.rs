@@ -1,24 +1,41 @@
 //! Chi-square tests of aperture sampling: disc, regular n-gons (n = 3, 5, 6, 8) and an
-//! image mask. Samples are binned on a grid over the aperture's square; the expected count
-//! of a cell is N · (area of cell ∩ aperture) / (aperture area), computed exactly by
-//! clipping the cell against the (convex) aperture polygon — independent of the sampler's
-//! own `pdf`. Cells expecting fewer than 5 samples are pooled, as usual for Pearson's
-//! test. Each test rejects at α = 0.01/6 (Šidák-style correction over the six tests of
-//! this file, as Mitsuba's chi-square harness does), so a correct sampler fails this file
-//! with probability ≈ 1%; with fixed seeds the outcome is deterministic.
-
-mod common;
+//! image mask, two ways:
+//!
+//! - with `candela_core::chi2`'s planar harness, samples against the aperture's own `pdf`
+//!   (which must also integrate to one);
+//! - against the geometry itself: on a grid over [-1,1]², the probability of a cell is
+//!   (area of cell ∩ aperture) / (aperture area), computed exactly by clipping the cell
+//!   against the convex aperture polygon, independent of the sampler's `pdf`; the counts
+//!   go through `chi2::discrete`.
+//!
+//! 10⁶ samples per test and fixed seeds; the file's family-wise significance is 0.01,
+//! split over its 11 chi-square tests by the Šidák correction, so a correct sampler fails
+//! this file with probability ≈ 1% (deterministically, given the seeds).
 
 use std::f64::consts::TAU;
 
 use candela_core::camera::Aperture;
+use candela_core::chi2::{discrete, sidak_alpha, ChiSquareTest};
 use candela_core::desc::ApertureDesc;
 use candela_core::sampler::Pcg32;
 use glam::{DVec2, Vec2};
 
 const N: usize = 1_000_000;
 const GRID: usize = 48;
-const ALPHA: f64 = 0.01 / 6.0;
+/// Chi-square tests in this file, for the Šidák correction.
+const TESTS: usize = 11;
+
+fn alpha() -> f64 {
+    sidak_alpha(0.01, TESTS)
+}
+
+fn harness(seed: u64) -> ChiSquareTest {
+    ChiSquareTest {
+        alpha: alpha(),
+        seed,
+        ..Default::default()
+    }
+}
 
 /// Sutherland–Hodgman clip of a convex polygon to an axis-aligned box, then its area.
 fn clipped_area(poly: &[DVec2], lo: DVec2, hi: DVec2) -> f64 {
@@ -74,27 +91,6 @@ fn regular_polygon(n: usize, rotation: f64) -> Vec<DVec2> {
         .collect()
 }
 
-/// Pearson's statistic with pooling of small cells; returns (χ², dof, p).
-fn pearson(observed: &[f64], expected: &[f64]) -> (f64, f64, f64) {
-    let (mut chi2, mut cells) = (0.0, 0usize);
-    let (mut pooled_o, mut pooled_e) = (0.0, 0.0);
-    for (&o, &e) in observed.iter().zip(expected) {
-        if e < 5.0 {
-            pooled_o += o;
-            pooled_e += e;
-        } else {
-            chi2 += (o - e) * (o - e) / e;
-            cells += 1;
-        }
-    }
-    if pooled_e > 0.0 {
-        chi2 += (pooled_o - pooled_e) * (pooled_o - pooled_e) / pooled_e;
-        cells += 1;
-    }
-    let dof = cells as f64 - 1.0;
-    (chi2, dof, common::chi2_sf(chi2, dof))
-}
-
 fn samples(aperture: &Aperture, seed: u64) -> impl Iterator<Item = Vec2> + '_ {
     let mut rng = Pcg32::new(seed, 1);
     (0..N).map(move |_| {
@@ -103,38 +99,45 @@ fn samples(aperture: &Aperture, seed: u64) -> impl Iterator<Item = Vec2> + '_ {
     })
 }
 
-/// Bins samples on the GRID×GRID grid over [-1,1]² and tests them against `shape`.
+/// Tests an aperture against the convex polygon `shape` it should fill uniformly: with
+/// the harness (against its own pdf) and against the exact cell areas of the shape.
 fn check_convex(name: &str, aperture: &Aperture, shape: &[DVec2], seed: u64) {
+    let report = harness(seed).planar(
+        name,
+        Vec2::splat(-1.0),
+        Vec2::ONE,
+        |u| Some(aperture.sample(u)),
+        |p| aperture.pdf(p),
+    );
+    println!(
+        "{name}: harness χ² = {:.1}, dof = {}, p = {:.3}, ∫pdf = {:.5}",
+        report.statistic, report.dof, report.p_value, report.pdf_integral
+    );
+    report.assert_passed();
+
     let area = shoelace(shape);
     let cell = 2.0 / GRID as f64;
-    let mut expected = vec![0.0; GRID * GRID];
+    let mut pmf = vec![0.0; GRID * GRID];
     for j in 0..GRID {
         for i in 0..GRID {
             let lo = DVec2::new(-1.0 + i as f64 * cell, -1.0 + j as f64 * cell);
-            expected[j * GRID + i] =
-                N as f64 * clipped_area(shape, lo, lo + DVec2::splat(cell)) / area;
+            pmf[j * GRID + i] = clipped_area(shape, lo, lo + DVec2::splat(cell)) / area;
         }
     }
-    let mut observed = vec![0.0; GRID * GRID];
-    for p in samples(aperture, seed) {
+    let mut counts = vec![0u64; GRID * GRID];
+    for p in samples(aperture, seed + 1000) {
         assert!(p.is_finite() && p.abs().max_element() <= 1.0, "{name}: {p}");
         let ij = ((p + Vec2::ONE) / cell as f32)
             .as_uvec2()
             .min(glam::UVec2::splat(GRID as u32 - 1));
-        observed[ij.y as usize * GRID + ij.x as usize] += 1.0;
-        // The sampler's own density agrees with the shape's area.
-        let pdf = aperture.pdf(p);
-        assert!(
-            pdf == 0.0 || (pdf as f64 * area - 1.0).abs() < 1e-4,
-            "{name}: pdf {pdf}"
-        );
+        counts[ij.y as usize * GRID + ij.x as usize] += 1;
     }
-    let (chi2, dof, p) = pearson(&observed, &expected);
-    println!("{name}: chi2 = {chi2:.1}, dof = {dof}, p = {p:.4}");
-    assert!(
-        p > ALPHA,
-        "{name}: chi2 = {chi2:.1} with {dof} dof, p = {p:.2e} < {ALPHA:.2e}"
+    let report = discrete(&format!("{name} vs exact areas"), &counts, &pmf, alpha());
+    println!(
+        "{name}: exact-area χ² = {:.1}, dof = {}, p = {:.3}",
+        report.statistic, report.dof, report.p_value
     );
+    report.assert_passed();
 }
 
 #[test]
@@ -177,58 +180,70 @@ fn image_aperture_follows_luminance() {
         luminance: lum.clone(),
     };
     let aperture = Aperture::new(&desc);
-    let total: f64 = lum.iter().map(|&v| v as f64).sum();
     // The longer side (12 px) spans the diameter: the mask covers [-1,1]×[-2/3,2/3].
     let half = DVec2::new(1.0, h as f64 / w as f64);
-    let mut observed = vec![0.0; w * h];
-    for p in samples(&aperture, 31) {
+    // 24 cells a side: two cells per image column, three per row, so no cell straddles
+    // a pixel edge.
+    let report = ChiSquareTest {
+        res: 24,
+        ..harness(31)
+    }
+    .planar(
+        "image",
+        -half.as_vec2(),
+        half.as_vec2(),
+        |u| Some(aperture.sample(u)),
+        |p| aperture.pdf(p),
+    );
+    println!(
+        "image: harness χ² = {:.1}, dof = {}, p = {:.3}, ∫pdf = {:.5}",
+        report.statistic, report.dof, report.p_value, report.pdf_integral
+    );
+    report.assert_passed();
+
+    // Against the luminances themselves: one outcome per image pixel.
+    let total: f64 = lum.iter().map(|&v| v as f64).sum();
+    let pmf: Vec<f64> = lum.iter().map(|&v| v as f64 / total).collect();
+    let mut counts = vec![0u64; w * h];
+    for p in samples(&aperture, 32) {
         let p = p.as_dvec2();
         assert!(p.x.abs() <= half.x && p.y.abs() <= half.y, "{p}");
+        // Image rows run downwards from the top of the aperture.
         let col = (((p.x / half.x + 1.0) * 0.5 * w as f64) as usize).min(w - 1);
         let row = (((1.0 - p.y / half.y) * 0.5 * h as f64) as usize).min(h - 1);
-        let k = row * w + col;
-        assert!(lum[k] > 0.0, "sample {p} in black pixel ({col}, {row})");
-        observed[k] += 1.0;
-        // Density per lens area: luminance share over the pixel's area.
-        let pixel_area = 4.0 * half.x * half.y / (w * h) as f64;
-        let want = lum[k] as f64 / total / pixel_area;
-        assert!((aperture.pdf(p.as_vec2()) as f64 / want - 1.0).abs() < 1e-4);
+        counts[row * w + col] += 1;
     }
-    let expected: Vec<f64> = lum.iter().map(|&v| N as f64 * v as f64 / total).collect();
-    let lit: Vec<usize> = (0..w * h).filter(|&k| lum[k] > 0.0).collect();
-    let o: Vec<f64> = lit.iter().map(|&k| observed[k]).collect();
-    let e: Vec<f64> = lit.iter().map(|&k| expected[k]).collect();
-    let (chi2, dof, p) = pearson(&o, &e);
-    println!("image: chi2 = {chi2:.1}, dof = {dof}, p = {p:.4}");
-    assert!(
-        p > ALPHA,
-        "image: chi2 = {chi2:.1} with {dof} dof, p = {p:.2e}"
+    let report = discrete("image vs luminance", &counts, &pmf, alpha());
+    println!(
+        "image: luminance χ² = {:.1}, dof = {}, p = {:.3}",
+        report.statistic, report.dof, report.p_value
     );
+    report.assert_passed();
 }
 
 #[test]
 fn the_test_rejects_a_biased_sampler() {
-    // A disc sampled with r = u (not √u) crowds the centre: the test must catch it.
+    // A disc sampled with r = u (not √u) crowds the centre: the exact-area test must
+    // catch it. (Not counted in TESTS: it is meant to fail.)
     let circle = regular_polygon(4096, 0.0);
+    let area = shoelace(&circle);
     let cell = 2.0 / GRID as f64;
-    let mut expected = vec![0.0; GRID * GRID];
+    let mut pmf = vec![0.0; GRID * GRID];
     for j in 0..GRID {
         for i in 0..GRID {
             let lo = DVec2::new(-1.0 + i as f64 * cell, -1.0 + j as f64 * cell);
-            expected[j * GRID + i] =
-                N as f64 * clipped_area(&circle, lo, lo + DVec2::splat(cell)) / shoelace(&circle);
+            pmf[j * GRID + i] = clipped_area(&circle, lo, lo + DVec2::splat(cell)) / area;
         }
     }
     let mut rng = Pcg32::new(5, 1);
-    let mut observed = vec![0.0; GRID * GRID];
+    let mut counts = vec![0u64; GRID * GRID];
     for _ in 0..N {
         let (r, phi) = (rng.uniform_f32() as f64, TAU * rng.uniform_f32() as f64);
         let p = DVec2::new(r * phi.cos(), r * phi.sin());
         let ij = ((p + DVec2::ONE) / cell)
             .as_uvec2()
             .min(glam::UVec2::splat(GRID as u32 - 1));
-        observed[ij.y as usize * GRID + ij.x as usize] += 1.0;
+        counts[ij.y as usize * GRID + ij.x as usize] += 1;
     }
-    let (_, _, p) = pearson(&observed, &expected);
-    assert!(p < ALPHA, "a biased sampler passed: p = {p}");
+    assert!(!discrete("biased disc", &counts, &pmf, alpha()).passed());
 }
