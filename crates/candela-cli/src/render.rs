@@ -52,12 +52,12 @@ pub struct RenderArgs {
     light_sampler: Option<LightSamplerArg>,
     /// Focus distance of a thin lens, in scene units along the view axis (a pinhole
     /// scene also needs --f-number to blur).
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     focus_distance: Option<f32>,
     /// f-number of a thin lens (aperture radius = focal length / 2N, scene units taken as
     /// metres); turns a pinhole into a thin lens with a disc aperture, focused on look_at
     /// unless --focus-distance says otherwise.
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     f_number: Option<f32>,
 }
 
