@@ -136,20 +136,25 @@ def render_report(a, variants, runs, ref, ref_meta) -> str:
         if key == "candela":
             times = [r["render_s"] for r in rs]
             procs = [r["process_s"] for r in rs]
+            cpus = [r["cpu_s"] for r in rs]
             loads = [r["load_before"].split()[0] for r in rs]
             mrays = report.fmt(statistics.median(r["mrays_per_s"] for r in rs))
             warm = "—"
         else:
             times = [r["renders"][0]["wall_s"] for r in rs]
             procs = [r["process_s"] for r in rs]
+            cpus = [r["renders"][0]["cpu_s"] for r in rs]
             loads = [r["renders"][0]["load"].split()[0] for r in rs]
             mrays = "n/a"
             warm = report.fmt(statistics.median(r["warm"][0]["wall_s"] for r in rs))
         imgs = [images.load_exr(r["out"]) for r in rs]
         first_images[key] = imgs[0]
         t = statistics.median(times)
+        cpu = statistics.median(cpus)
+        cpu_candela = statistics.median(r["cpu_s"] for r in runs["candela"])
         rows.append([name[key], report.fmt(t), report.fmt(min(times)), warm,
-                     report.fmt(t / t_candela), report.fmt(statistics.median(procs)),
+                     report.fmt(t / t_candela), report.fmt(cpu), report.fmt(cpu / cpu_candela),
+                     report.fmt(statistics.median(procs)),
                      report.fmt(pixels / t / 1e6), mrays,
                      f"{statistics.mean(images.relmse(x, ref) for x in imgs):.5f}",
                      " ".join(loads)])
@@ -177,7 +182,7 @@ def render_report(a, variants, runs, ref, ref_meta) -> str:
         + (f"; Mitsuba {mi_run['mitsuba']} / Dr.Jit {mi_run['drjit']}" if mi_run else ""),
         "",
         report.table(["renderer", "render s (median)", "min s", "warm s", "× Candela",
-                      "process s", "M paths/s", "M rays/s", "relMSE", "load1 per run"],
+                      "CPU s", "CPU × Candela", "process s", "M paths/s", "M rays/s", "relMSE", "load1 per run"],
                      rows),
         "",
         f"Median of {a.repeats} interleaved runs, each Mitsuba run in a fresh process with "
@@ -185,7 +190,10 @@ def render_report(a, variants, runs, ref, ref_meta) -> str:
         "only, no load/BVH/write); for Mitsuba the first `mi.render` in the process "
         "(llvm_ad_rgb: with an empty kernel cache, so JIT compilation is included). "
         "*warm s*: a second `mi.render` in the same process (kernels compiled). "
-        "*× Candela*: render time ÷ Candela's (>1: Candela is faster). *process s*: whole "
+        "*× Candela*: render time ÷ Candela's (>1: Candela is faster). *CPU s*: user + "
+        "system CPU seconds of all threads over the same span (for Candela: its whole "
+        "process, which adds a little load/BVH/write time); on a loaded machine this is "
+        "the steadier measure, and ≈ wall × threads on an idle one. *process s*: whole "
         "process (start, load, render, write). *M paths/s* = pixels × spp ÷ render s. "
         f"*relMSE* (mean over runs) against the reference below, ε = {images.RELMSE_EPS}; "
         f"it includes the reference's own noise (≈ {a.spp / ref_meta['spp']:.3g} × a "

@@ -7,6 +7,7 @@ The whole process is also timed here, so both can be compared with Mitsuba's.
 """
 
 import re
+import resource
 import subprocess
 import time
 from dataclasses import dataclass
@@ -25,6 +26,7 @@ class CandelaRun:
     command: list
     render_s: float        # from the summary line: the integrator alone
     process_s: float       # the whole process, timed here
+    cpu_s: float           # user + system CPU of the whole process, all threads
     mpaths_per_s: float
     mrays_per_s: float
     load_before: str
@@ -48,9 +50,11 @@ def render(binary: str, scene: str, out: str, *, spp: int, max_depth: int, threa
     if seed is not None:
         cmd += ["--seed", str(seed)]
     load_before = machine.loadavg()
+    c0 = _children_cpu_s()
     t0 = time.perf_counter()
     p = subprocess.run(cmd, cwd=cwd, capture_output=True, text=True)
     process_s = time.perf_counter() - t0
+    cpu_s = _children_cpu_s() - c0
     if p.returncode != 0:
         raise RuntimeError(f"{' '.join(cmd)} failed ({p.returncode}):\n{p.stderr}{p.stdout}")
     m = parse_summary(p.stdout)
@@ -58,5 +62,11 @@ def render(binary: str, scene: str, out: str, *, spp: int, max_depth: int, threa
         raise RuntimeError(f"no summary line in candela's output:\n{p.stdout}")
     if (int(m["w"]), int(m["h"]), int(m["spp"])) != (res[0], res[1], spp):
         raise RuntimeError(f"candela rendered {m.group(0)}, not {res[0]}x{res[1]} at {spp} spp")
-    return CandelaRun(cmd, float(m["secs"]), process_s, float(m["paths"]), float(m["rays"]),
+    return CandelaRun(cmd, float(m["secs"]), process_s, cpu_s, float(m["paths"]),
+                      float(m["rays"]),
                       load_before, machine.loadavg(), m.group(0))
+
+
+def _children_cpu_s() -> float:
+    r = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return r.ru_utime + r.ru_stime
