@@ -1,0 +1,58 @@
+"""Image I/O and the error measures the comparisons use.
+
+Images are float64 numpy arrays of shape (height, width, 3), linear Rec.709 radiance.
+EXR is read and written through Mitsuba's own `mi.Bitmap` (so no OpenEXR binding is
+needed); any Mitsuba variant must be set before `load_exr`.
+"""
+
+import math
+
+import numpy as np
+
+# Two-sided significance of the mean-radiance z-tests: |z| above this at α = 0.001 says
+# the means differ. α is small because each comparison runs 3 channels × several images,
+# and a false alarm would send someone hunting for a bug that is not there.
+Z_CRIT = 3.29  # Φ⁻¹(1 − 0.001/2)
+
+# relMSE's ε: keeps black pixels from dominating (the usual 1e-2 of the literature, e.g.
+# Rousselle et al. 2011).
+RELMSE_EPS = 1e-2
+
+
+def load_exr(path: str) -> np.ndarray:
+    import mitsuba as mi
+    bmp = mi.Bitmap(path).convert(mi.Bitmap.PixelFormat.RGB, mi.Struct.Type.Float32,
+                                  srgb_gamma=False)
+    return np.array(bmp, dtype=np.float64)
+
+
+def relmse(x: np.ndarray, ref: np.ndarray) -> float:
+    """Mean over pixels and channels of (x − ref)² / (ref² + ε)."""
+    return float(np.mean((x - ref) ** 2 / (ref ** 2 + RELMSE_EPS)))
+
+
+def mean_rgb(x: np.ndarray) -> np.ndarray:
+    return x.reshape(-1, 3).mean(axis=0)
+
+
+def mean_difference_z(x: np.ndarray, y: np.ndarray) -> np.ndarray:
+    """Per channel, z = mean(x − y) / (std(x − y) / √N) over the N pixels.
+
+    Both images are Monte Carlo estimates of the same picture with independent samples in
+    every pixel, so under "same expected image" each pixel difference has mean 0 and the
+    pixels are independent: by the CLT z is standard normal (N = 262144 at 512²). A bias
+    in either renderer (geometry, camera, emitter side, depth convention) shows as |z|
+    far above Z_CRIT."""
+    d = (x - y).reshape(-1, 3)
+    se = d.std(axis=0, ddof=1) / math.sqrt(d.shape[0])
+    return d.mean(axis=0) / np.where(se > 0, se, np.inf)
+
+
+def red_wall_side(x: np.ndarray) -> str:
+    """"left" when the image's left third is redder (R/G) than its right third: the
+    Cornell box's red wall, seen from the standard camera, must be on the left."""
+    third = x.shape[1] // 3
+    def redness(part):
+        m = mean_rgb(part)
+        return m[0] / max(m[1], 1e-12)
+    return "left" if redness(x[:, :third]) > redness(x[:, -third:]) else "right"
