@@ -43,5 +43,6 @@ pub mod math;
 pub mod sampler;
 pub mod sampling;
 pub mod scene;
+pub mod texture;
 
 pub use scene::Scene;
