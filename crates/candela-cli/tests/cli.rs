@@ -1,0 +1,230 @@
+//! End-to-end tests of the `candela` binary: files written, exit codes, located errors,
+//! determinism, interruption.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+const SCENE: &str = r#"
+[render]
+resolution = [24, 16]
+spp = 4
+max_depth = 3
+
+[camera]
+type = "pinhole"
+position = [0, 1, 4]
+look_at = [0, 1, 0]
+fov = 45
+
+[materials.white]
+type = "diffuse"
+albedo = 0.7
+
+[[shape]]
+type = "rectangle"
+material = "white"
+transform = [{ rotate = { axis = [1, 0, 0], angle = -90 } }, { scale = 3 }]
+
+[[shape]]
+type = "sphere"
+center = [0, 1, 0]
+radius = 0.5
+material = "white"
+emission = [4, 3, 2]
+
+[[light]]
+type = "point"
+position = [1, 3, 1]
+intensity = 5
+"#;
+
+fn candela(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_candela"))
+        .args(args)
+        .output()
+        .expect("candela runs")
+}
+
+fn scene_dir(text: &str) -> (tempfile::TempDir, PathBuf) {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = dir.path().join("scene.toml");
+    std::fs::write(&scene, text).unwrap();
+    (dir, scene)
+}
+
+fn s(p: &Path) -> &str {
+    p.to_str().unwrap()
+}
+
+#[test]
+fn renders_every_output_format() {
+    let (dir, scene) = scene_dir(SCENE);
+    for ext in ["png", "exr", "pfm"] {
+        let out = dir.path().join(format!("out.{ext}"));
+        let o = candela(&["render", s(&scene), "-o", s(&out)]);
+        assert!(
+            o.status.success(),
+            "{ext}: {}",
+            String::from_utf8_lossy(&o.stderr)
+        );
+        let stdout = String::from_utf8_lossy(&o.stdout);
+        assert!(
+            stdout.contains("24x16, 4 spp") && stdout.contains("rays/s"),
+            "summary line: {stdout}"
+        );
+        let bytes = std::fs::read(&out).unwrap();
+        let magic: &[u8] = match ext {
+            "png" => b"\x89PNG",
+            "exr" => &[0x76, 0x2f, 0x31, 0x01],
+            _ => b"PF\n24 16\n",
+        };
+        assert!(bytes.starts_with(magic), "{ext} header");
+    }
+    let png = image::open(dir.path().join("out.png")).unwrap();
+    assert_eq!((png.width(), png.height()), (24, 16));
+    // No temporary files are left behind.
+    let leftovers: Vec<_> = std::fs::read_dir(dir.path())
+        .unwrap()
+        .filter_map(|e| e.ok())
+        .filter(|e| e.file_name().to_string_lossy().starts_with(".candela-"))
+        .collect();
+    assert!(leftovers.is_empty());
+}
+
+#[test]
+fn same_seed_gives_the_same_image_whatever_the_thread_count() {
+    let (dir, scene) = scene_dir(SCENE);
+    let render = |name: &str, extra: &[&str]| {
+        let out = dir.path().join(name);
+        let mut args = vec!["render", s(&scene), "-o", s(&out)];
+        args.extend_from_slice(extra);
+        assert!(candela(&args).status.success());
+        std::fs::read(out).unwrap()
+    };
+    let a = render("a.pfm", &["--threads", "1", "--seed", "3"]);
+    let b = render("b.pfm", &["--threads", "2", "--seed", "3"]);
+    let c = render("c.pfm", &["--threads", "2", "--seed", "4"]);
+    assert_eq!(a, b, "thread count changed the image");
+    assert_ne!(a, c, "the seed did not change the image");
+}
+
+#[test]
+fn overrides_change_resolution() {
+    let (dir, scene) = scene_dir(SCENE);
+    let out = dir.path().join("o.png");
+    let o = candela(&[
+        "render",
+        s(&scene),
+        "-o",
+        s(&out),
+        "--res",
+        "10x7",
+        "--spp",
+        "2",
+        "--max-depth",
+        "1",
+    ]);
+    assert!(o.status.success());
+    let png = image::open(&out).unwrap();
+    assert_eq!((png.width(), png.height()), (10, 7));
+}
+
+#[test]
+fn malformed_scene_gives_exit_2_and_a_located_message_and_keeps_old_output() {
+    let bad = SCENE.replace("fov = 45", "fvo = 45");
+    let (dir, scene) = scene_dir(&bad);
+    let out = dir.path().join("keep.png");
+    std::fs::write(&out, b"previous image").unwrap();
+    let o = candela(&["render", s(&scene), "-o", s(&out)]);
+    assert_eq!(o.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&o.stderr);
+    let line = SCENE.lines().position(|l| l.starts_with("fov")).unwrap() + 1;
+    assert!(
+        err.contains(&format!("scene.toml:{line}:")),
+        "location missing: {err}"
+    );
+    assert!(err.contains("fvo"), "message should name the key: {err}");
+    assert_eq!(err.trim().lines().count(), 1, "one line: {err}");
+    assert_eq!(std::fs::read(&out).unwrap(), b"previous image");
+}
+
+#[test]
+fn unknown_material_and_missing_scene_are_user_errors() {
+    let (dir, scene) = scene_dir(&SCENE.replace(
+        "material = \"white\"\nemission",
+        "material = \"gold\"\nemission",
+    ));
+    let o = candela(&["render", s(&scene), "-o", s(&dir.path().join("x.png"))]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("unknown material \"gold\""));
+    let o = candela(&["render", "does/not/exist.toml", "-o", "x.png"]);
+    assert_eq!(o.status.code(), Some(2));
+    let o = candela(&["render", s(&scene), "-o", "x.jpg"]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("unsupported output format"));
+}
+
+#[test]
+fn unwritable_output_is_a_clear_error() {
+    let (dir, scene) = scene_dir(SCENE);
+    let out = dir.path().join("no/such/folder/x.png");
+    let o = candela(&["render", s(&scene), "-o", s(&out)]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("cannot write"));
+}
+
+#[test]
+fn info_describes_the_scene() {
+    let (_dir, scene) = scene_dir(SCENE);
+    let o = candela(&["info", s(&scene)]);
+    assert!(o.status.success());
+    let text = String::from_utf8_lossy(&o.stdout);
+    assert!(text.contains("triangles  2"), "{text}");
+    assert!(text.contains("lights     2"), "{text}");
+    assert!(text.contains("materials  1 (white)"), "{text}");
+}
+
+#[cfg(unix)]
+#[test]
+fn interrupt_writes_the_partial_image() {
+    let (dir, scene) = scene_dir(SCENE);
+    let out = dir.path().join("partial.pfm");
+    // Enough samples to be still rendering when the signal arrives.
+    let child = Command::new(env!("CARGO_BIN_EXE_candela"))
+        .args([
+            "render",
+            s(&scene),
+            "-o",
+            s(&out),
+            "--spp",
+            "2000000",
+            "--threads",
+            "1",
+        ])
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    std::thread::sleep(std::time::Duration::from_millis(1500));
+    let killed = Command::new("kill")
+        .args(["-INT", &child.id().to_string()])
+        .status()
+        .unwrap();
+    assert!(killed.success());
+    let o = child.wait_with_output().unwrap();
+    assert_eq!(
+        o.status.code(),
+        Some(130),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    assert!(String::from_utf8_lossy(&o.stderr).contains("partial image"));
+    let bytes = std::fs::read(&out).unwrap();
+    assert!(bytes.starts_with(b"PF\n24 16\n"));
+    // The partial image is a real image: some pixel is lit.
+    let floats: Vec<f32> = bytes[b"PF\n24 16\n-1.0\n".len()..]
+        .chunks(4)
+        .map(|c| f32::from_le_bytes(c.try_into().unwrap()))
+        .collect();
+    assert!(floats.iter().any(|&v| v > 0.0) && floats.iter().all(|v| v.is_finite()));
+}
