@@ -7,6 +7,9 @@ use std::fmt;
 
 use glam::{Mat3, Mat4, Vec2, Vec3};
 
+use crate::bsdf::{
+    Conductor, ConductorFresnel, Dielectric, Lobe, Plastic, ThinDielectric, TrowbridgeReitz,
+};
 use crate::bvh::Bvh;
 use crate::camera::Camera;
 use crate::desc::{
@@ -15,10 +18,9 @@ use crate::desc::{
 use crate::geometry::Aabb;
 use crate::light::{Light, LightId, PointLight, SphereLight, TriangleLight};
 use crate::light_sampler::LightSampler;
-use crate::bsdf::{Conductor, ConductorFresnel, Dielectric, Lobe, Plastic, ThinDielectric, TrowbridgeReitz};
 use crate::material::{Material, MaterialId, Texture};
-use crate::texture::ImageTexture;
 use crate::scene::{Mesh, Prim, Scene, Sphere};
+use crate::texture::ImageTexture;
 
 /// A description that cannot be built, with the place that caused it.
 #[derive(Clone, Debug, PartialEq, Eq)]
@@ -268,8 +270,15 @@ fn build_texture(t: &TextureDesc, span: &Span, what: &str) -> Result<Texture, Bu
                     ),
                 );
             }
-            if img.pixels.iter().any(|p| !p.is_finite() || p.min_element() < 0.0) {
-                return err(span, format!("{what} image has negative or non-finite pixels"));
+            if img
+                .pixels
+                .iter()
+                .any(|p| !p.is_finite() || p.min_element() < 0.0)
+            {
+                return err(
+                    span,
+                    format!("{what} image has negative or non-finite pixels"),
+                );
             }
             check_color(span, what, t.scale)?;
             check_finite(span, what, &t.uv_transform.to_cols_array())?;

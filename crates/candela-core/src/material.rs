@@ -85,7 +85,11 @@ impl Material {
 pub fn normal_mapped(ns: Vec3, ng: Vec3, dpdu: Vec3, texel: Vec3) -> Vec3 {
     let m = texel * 2.0 - Vec3::ONE;
     let t = (dpdu - ns * ns.dot(dpdu)).normalize_or_zero();
-    let t = if t == Vec3::ZERO { Frame::from_z(ns).s } else { t };
+    let t = if t == Vec3::ZERO {
+        Frame::from_z(ns).s
+    } else {
+        t
+    };
     let b = ns.cross(t);
     let n = (t * m.x + b * m.y + ns * m.z).normalize_or_zero();
     let ng = if ng.dot(ns) < 0.0 { -ng } else { ng };

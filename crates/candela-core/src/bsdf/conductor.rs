@@ -99,10 +99,26 @@ impl Conductor {
 /// from the spectra Mitsuba 0.5 ships, after Palik's *Handbook of Optical Constants of
 /// Solids*); the spectral curves were reduced to RGB once, by their tables' authors.
 pub const METAL_PRESETS: [(&str, [f32; 3], [f32; 3]); 5] = [
-    ("Au", [0.143119, 0.374957, 1.44248], [3.98316, 2.38572, 1.60322]),
-    ("Ag", [0.155265, 0.116723, 0.138342], [4.82835, 3.12225, 2.14696]),
-    ("Cu", [0.200438, 0.924033, 1.10221], [3.91295, 2.45285, 2.14219]),
-    ("Al", [1.65746, 0.880369, 0.521229], [9.22387, 6.26952, 4.837]),
+    (
+        "Au",
+        [0.143119, 0.374957, 1.44248],
+        [3.98316, 2.38572, 1.60322],
+    ),
+    (
+        "Ag",
+        [0.155265, 0.116723, 0.138342],
+        [4.82835, 3.12225, 2.14696],
+    ),
+    (
+        "Cu",
+        [0.200438, 0.924033, 1.10221],
+        [3.91295, 2.45285, 2.14219],
+    ),
+    (
+        "Al",
+        [1.65746, 0.880369, 0.521229],
+        [9.22387, 6.26952, 4.837],
+    ),
     ("Cr", [4.36968, 2.9167, 1.6547], [5.20643, 4.23136, 3.75495]),
 ];
 
@@ -125,7 +141,10 @@ mod tests {
             fresnel_conductor(1.0, eta, k)
         };
         let (au, ag, cu, al) = (r0("au"), r0("Ag"), r0("Cu"), r0("Al"));
-        assert!(au.x > au.y && au.y > au.z && au.z < 0.5, "gold is yellow: {au}");
+        assert!(
+            au.x > au.y && au.y > au.z && au.z < 0.5,
+            "gold is yellow: {au}"
+        );
         assert!(cu.x > cu.y && cu.x > cu.z, "copper is red: {cu}");
         assert!(ag.min_element() > 0.9, "silver is bright and grey: {ag}");
         assert!(al.min_element() > 0.85, "aluminium is bright: {al}");

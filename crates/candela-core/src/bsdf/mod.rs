@@ -199,7 +199,11 @@ impl Bsdf {
             return Bsdf::new(ns, ng, lobe);
         }
         Bsdf {
-            frame: Frame { s, t: ns.cross(s), n: ns },
+            frame: Frame {
+                s,
+                t: ns.cross(s),
+                n: ns,
+            },
             ng,
             lobe,
         }

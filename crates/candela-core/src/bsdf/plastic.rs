@@ -4,7 +4,7 @@ use std::f32::consts::FRAC_1_PI;
 
 use glam::{Vec2, Vec3};
 
-use super::fresnel::{fresnel_diffuse_reflectance, fresnel_dielectric};
+use super::fresnel::{fresnel_dielectric, fresnel_diffuse_reflectance};
 use super::{BsdfFlags, BsdfSample};
 use crate::sampling::{cosine_hemisphere_pdf, sample_cosine_hemisphere};
 
