@@ -11,7 +11,12 @@ use crate::sampling::{cosine_hemisphere_pdf, sample_cosine_hemisphere};
 
 /// glTF's BRDF: F₀ = mix(0.04, base, metallic) (0.04 is ior 1.5); specular = F·D·G/(4
 /// cos θo cos θi) with GGX of α = roughness² and Schlick's F at ωo·ωh; diffuse =
-/// (1 − F)(1 − metallic)·base/π, the spec's `fresnel_mix`. Sampled by choosing the
+/// (1 − F(θo))(1 − F(θi))(1 − metallic)·base/π.
+///
+/// The diffuse weight departs from the spec's `fresnel_mix` (1 − F(ωo·ωh)): that form
+/// returns up to 2.5% more energy than it receives for a white base (measured by
+/// `tests/bsdf_energy.rs` at roughness 0.05, θo = 60°). Weighting by the Fresnel
+/// transmittance in and out (as a coat would) is reciprocal and stays below 1. Sampled by choosing the
 /// specular lobe (visible normals) or the cosine-weighted diffuse one in proportion to
 /// their rough share of the albedo; `pdf` is the mixture density of both.
 #[derive(Clone, Copy, Debug)]
@@ -59,9 +64,12 @@ impl MetalRough {
         if wm == Vec3::ZERO {
             return Vec3::ZERO;
         }
-        let f = fresnel_schlick(self.f0(), wo.dot(wm));
+        let f0 = self.f0();
+        let f = fresnel_schlick(f0, wo.dot(wm));
         let spec = f * (self.distrib.d(wm) * self.distrib.g(wo, wi) / (4.0 * wo.z * wi.z));
-        spec + (Vec3::ONE - f) * self.diffuse_color() * FRAC_1_PI
+        let transmit =
+            (Vec3::ONE - fresnel_schlick(f0, wo.z)) * (Vec3::ONE - fresnel_schlick(f0, wi.z));
+        spec + transmit * self.diffuse_color() * FRAC_1_PI
     }
 
     pub fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
