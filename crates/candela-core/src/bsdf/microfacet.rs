@@ -66,12 +66,12 @@ impl TrowbridgeReitz {
     }
 
     /// Density of visible normals from `w`: G₁(ω)/|cos θ| · D(ωm) · |ω·ωm| (Heitz 2014,
-    /// eq. 38). Integrates to 1 over ωm.
+    /// eq. 38); back-facing normals (ω·ωm < 0) are invisible. Integrates to 1 over ωm.
     pub fn d_visible(&self, w: Vec3, wm: Vec3) -> f32 {
         if w.z == 0.0 {
             return 0.0;
         }
-        self.g1(w) / w.z.abs() * self.d(wm) * w.dot(wm).abs()
+        self.g1(w) / w.z.abs() * self.d(wm) * w.dot(wm).max(0.0)
     }
 
     /// Samples a visible normal seen from `w` (either hemisphere: `w` is mirrored to the
