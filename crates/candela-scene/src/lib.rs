@@ -32,6 +32,7 @@ use std::sync::Arc;
 
 use candela_core::desc::{MeshDesc, SceneDesc, Span};
 
+pub mod image_texture;
 pub mod obj;
 pub mod ply;
 pub mod toml_scene;
