@@ -99,3 +99,34 @@ pub fn normal_mapped(ns: Vec3, ng: Vec3, dpdu: Vec3, texel: Vec3) -> Vec3 {
         n
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn normal_map_follows_the_tangent_and_never_faces_away() {
+        let (ns, ng, dpdu) = (Vec3::Z, Vec3::Z, Vec3::X);
+        // The flat texel (0.5, 0.5, 1) keeps the normal.
+        let flat = normal_mapped(ns, ng, dpdu, Vec3::new(0.5, 0.5, 1.0));
+        assert!((flat - Vec3::Z).length() < 1e-6);
+        // Tilted towards +u.
+        let n = normal_mapped(ns, ng, dpdu, Vec3::new(0.85, 0.5, 0.85));
+        assert!(
+            n.x > 0.3 && n.y.abs() < 1e-6 && (n.length() - 1.0).abs() < 1e-5,
+            "{n}"
+        );
+        // Degenerate or back-facing texels and tangents fall back to the shading normal.
+        for texel in [
+            Vec3::splat(0.5),
+            Vec3::new(0.5, 0.5, 0.0),
+            Vec3::new(1.0, 0.5, 0.5),
+            Vec3::NAN,
+        ] {
+            for t in [Vec3::X, Vec3::ZERO, Vec3::Z, Vec3::NAN] {
+                let n = normal_mapped(ns, ng, t, texel);
+                assert!(n.is_finite() && n.dot(ng) >= 0.1, "{texel} {t}: {n}");
+            }
+        }
+    }
+}

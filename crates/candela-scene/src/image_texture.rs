@@ -26,7 +26,7 @@ impl Encoding {
     pub fn decode(self, v: f32) -> f32 {
         match self {
             Encoding::Srgb => srgb_decode(v),
-            Encoding::Gamma(g) if g == 1.0 => v,
+            Encoding::Gamma(1.0) => v,
             Encoding::Gamma(g) => v.max(0.0).powf(g),
         }
     }
