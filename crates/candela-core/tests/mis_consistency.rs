@@ -56,6 +56,7 @@ fn cornell(mis: MisMode, light_scale: f32) -> SceneDesc {
             up: Vec3::Y,
             fov_y_deg: 39.3077,
             span: Span::code(),
+            ..Default::default()
         },
         render: RenderSettings {
             width: RES,
@@ -65,6 +66,7 @@ fn cornell(mis: MisMode, light_scale: f32) -> SceneDesc {
             seed: 0,
             mis,
             light_sampler: LightSamplerKind::Power,
+            ..Default::default()
         },
         ..Default::default()
     };

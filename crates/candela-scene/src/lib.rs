@@ -35,6 +35,7 @@ use candela_core::desc::{MeshDesc, SceneDesc, Span};
 pub mod image_texture;
 pub mod obj;
 pub mod ply;
+mod toml_camera;
 mod toml_material;
 pub mod toml_scene;
 mod toml_shape;
