@@ -8,6 +8,7 @@ mod ies;
 mod info;
 mod output;
 mod render;
+mod tonemap;
 
 use std::path::PathBuf;
 use std::process::ExitCode;

@@ -1,14 +1,14 @@
 //! Image output. The format follows the file extension: `.exr` (linear float, OpenEXR),
-//! `.pfm` (linear float, portable float map), `.png` (8-bit sRGB after exposure). Every
+//! `.pfm` (linear float, portable float map), `.png` (8-bit sRGB after exposure and the tone curve, see `tonemap`). Every
 //! image is encoded in memory, written to a temporary file in the destination folder and
 //! renamed over the destination, so an existing file is never left half-written.
 
 use std::io::{Cursor, Write};
 use std::path::Path;
 
-use candela_core::color::{srgb_encode, to_u8};
 use glam::Vec3;
 
+use crate::tonemap::DisplayTransform;
 use crate::UserError;
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -43,12 +43,17 @@ pub struct LinearImage<'a> {
     pub pixels: &'a [Vec3],
 }
 
-/// Encodes and atomically writes an image. `exposure` is in stops and applies to PNG only.
-pub fn write_image(path: &Path, image: &LinearImage, exposure: f32) -> Result<(), UserError> {
+/// Encodes and atomically writes an image. The display transform (exposure, tone curve,
+/// OETF) applies to PNG only; EXR and PFM stay linear.
+pub fn write_image(
+    path: &Path,
+    image: &LinearImage,
+    display: &DisplayTransform,
+) -> Result<(), UserError> {
     let bytes = match ImageFormat::from_path(path)? {
         ImageFormat::Exr => encode_exr(image),
         ImageFormat::Pfm => Ok(encode_pfm(image)),
-        ImageFormat::Png => encode_png(image, exposure),
+        ImageFormat::Png => encode_png(image, display),
     }
     .map_err(|e| UserError(format!("{}: cannot encode image: {e}", path.display())))?;
     write_atomically(path, &bytes)
@@ -101,11 +106,9 @@ fn encode_pfm(image: &LinearImage) -> Vec<u8> {
     out
 }
 
-fn encode_png(image: &LinearImage, exposure: f32) -> Result<Vec<u8>, String> {
-    let scale = exposure.exp2();
+fn encode_png(image: &LinearImage, display: &DisplayTransform) -> Result<Vec<u8>, String> {
     let rgb = image::RgbImage::from_fn(image.width, image.height, |x, y| {
-        let p = image.pixels[(y * image.width + x) as usize] * scale;
-        image::Rgb(p.to_array().map(|c| to_u8(srgb_encode(c))))
+        image::Rgb(display.encode(image.pixels[(y * image.width + x) as usize]))
     });
     let mut out = Cursor::new(Vec::new());
     rgb.write_to(&mut out, image::ImageFormat::Png)

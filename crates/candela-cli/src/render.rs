@@ -17,6 +17,7 @@ use clap::{Args, ValueEnum};
 use indicatif::{ProgressBar, ProgressStyle};
 
 use crate::output::{write_image, ImageFormat, LinearImage};
+use crate::tonemap::{DisplayTransform, Tonemap};
 use crate::{MisArg, UserError};
 
 #[derive(Args)]
@@ -44,6 +45,12 @@ pub struct RenderArgs {
     /// Exposure in stops, applied before PNG encoding.
     #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
     exposure: f32,
+    /// Tone curve applied before PNG encoding (EXR/PFM stay linear).
+    #[arg(long, value_enum, default_value_t = Tonemap::None)]
+    tonemap: Tonemap,
+    /// Encode PNG with a pure power law 1/γ instead of the sRGB curve, e.g. 2.2.
+    #[arg(long, value_parser = parse_gamma)]
+    gamma: Option<f32>,
     /// MIS heuristic between light and BSDF sampling.
     #[arg(long, value_enum)]
     mis: Option<MisArg>,
@@ -72,6 +79,13 @@ pub enum LightSamplerArg {
     Ris,
     Bvh,
     RisBvh,
+}
+
+fn parse_gamma(s: &str) -> Result<f32, String> {
+    match s.trim().parse::<f32>() {
+        Ok(g) if g.is_finite() && g > 0.0 => Ok(g),
+        _ => Err(format!("expected a positive number, got \"{s}\"")),
+    }
 }
 
 fn parse_resolution(s: &str) -> Result<(u32, u32), String> {
@@ -181,7 +195,12 @@ pub fn run(args: RenderArgs) -> Result<ExitCode, UserError> {
         height: s.height,
         pixels: &pixels,
     };
-    write_image(&args.output, &image, args.exposure)?;
+    let display = DisplayTransform {
+        exposure: args.exposure,
+        tonemap: args.tonemap,
+        gamma: args.gamma,
+    };
+    write_image(&args.output, &image, &display)?;
 
     let st = result.stats;
     println!(

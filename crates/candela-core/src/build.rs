@@ -7,6 +7,9 @@ use std::fmt;
 
 use glam::{Mat3, Mat4, Vec2, Vec3};
 
+use crate::bsdf::{
+    Conductor, ConductorFresnel, Dielectric, Lobe, Plastic, ThinDielectric, TrowbridgeReitz,
+};
 use crate::bvh::Bvh;
 use crate::camera::Camera;
 use crate::desc::{
@@ -18,6 +21,7 @@ use crate::light::{Light, LightId, PointLight, SphereLight, TriangleLight};
 use crate::light_sampler::LightSampler;
 use crate::material::{Material, MaterialId, Texture};
 use crate::scene::{Mesh, Prim, Scene, Sphere};
+use crate::texture::ImageTexture;
 
 /// A description that cannot be built, with the place that caused it.
 #[derive(Clone, Debug, PartialEq, Eq)]
@@ -322,13 +326,129 @@ fn build_texture(t: &TextureDesc, span: &Span, what: &str) -> Result<Texture, Bu
             check_color(span, what, *c)?;
             Ok(Texture::Constant(*c))
         }
+        TextureDesc::Checker { a, b, uv_transform } => {
+            check_color(span, what, *a)?;
+            check_color(span, what, *b)?;
+            check_finite(span, what, &uv_transform.to_cols_array())?;
+            Ok(Texture::Checker {
+                a: *a,
+                b: *b,
+                uv_transform: *uv_transform,
+            })
+        }
+        TextureDesc::Image(t) => {
+            let img = &t.image;
+            if img.width == 0 || img.height == 0 {
+                return err(span, format!("{what} image is empty"));
+            }
+            if img.pixels.len() != img.width as usize * img.height as usize {
+                return err(
+                    span,
+                    format!(
+                        "{what} image has {} pixels for {}x{}",
+                        img.pixels.len(),
+                        img.width,
+                        img.height
+                    ),
+                );
+            }
+            if img
+                .pixels
+                .iter()
+                .any(|p| !p.is_finite() || p.min_element() < 0.0)
+            {
+                return err(
+                    span,
+                    format!("{what} image has negative or non-finite pixels"),
+                );
+            }
+            check_color(span, what, t.scale)?;
+            check_finite(span, what, &t.uv_transform.to_cols_array())?;
+            if t.channel.is_some_and(|c| c > 2) {
+                return err(span, format!("{what} channel must be 0, 1 or 2"));
+            }
+            Ok(Texture::Image(ImageTexture {
+                image: t.image.clone(),
+                wrap: t.wrap,
+                uv_transform: t.uv_transform,
+                scale: t.scale,
+                channel: t.channel,
+            }))
+        }
     }
+}
+
+fn check_alpha(span: &Span, alpha_u: f32, alpha_v: f32) -> Result<TrowbridgeReitz, BuildError> {
+    check_finite(span, "roughness", &[alpha_u, alpha_v])?;
+    if alpha_u < 0.0 || alpha_v < 0.0 {
+        return err(span, "roughness must not be negative");
+    }
+    // Tiny but non-zero α would overflow D; below the smooth threshold it is a mirror.
+    Ok(TrowbridgeReitz::new(alpha_u.max(1e-4), alpha_v.max(1e-4)))
+}
+
+fn check_eta(span: &Span, eta: f32) -> Result<(), BuildError> {
+    if !(eta.is_finite() && eta > 0.0) {
+        return err(span, format!("eta {eta} must be positive and finite"));
+    }
+    Ok(())
 }
 
 fn build_material(bsdf: &BsdfDesc, span: &Span) -> Result<Material, BuildError> {
     Ok(match bsdf {
         BsdfDesc::Diffuse { albedo } => Material::Diffuse {
             albedo: build_texture(albedo, span, "albedo")?,
+        },
+        BsdfDesc::Conductor {
+            eta,
+            k,
+            alpha_u,
+            alpha_v,
+        } => {
+            check_color(span, "eta", *eta)?;
+            check_color(span, "k", *k)?;
+            Material::Fixed(Lobe::Conductor(Conductor {
+                distrib: check_alpha(span, *alpha_u, *alpha_v)?,
+                fresnel: ConductorFresnel::Complex { eta: *eta, k: *k },
+            }))
+        }
+        BsdfDesc::Dielectric {
+            eta,
+            alpha_u,
+            alpha_v,
+            thin,
+        } => {
+            check_eta(span, *eta)?;
+            let distrib = check_alpha(span, *alpha_u, *alpha_v)?;
+            if *thin {
+                if !distrib.effectively_smooth() {
+                    return err(span, "a thin dielectric must be smooth (roughness 0)");
+                }
+                Material::Fixed(Lobe::ThinDielectric(ThinDielectric { eta: *eta }))
+            } else {
+                Material::Fixed(Lobe::Dielectric(Dielectric { eta: *eta, distrib }))
+            }
+        }
+        BsdfDesc::Plastic { albedo, eta } => {
+            check_eta(span, *eta)?;
+            Material::Plastic {
+                albedo: build_texture(albedo, span, "albedo")?,
+                coat: Plastic::new(Vec3::ONE, *eta),
+            }
+        }
+        BsdfDesc::MetalRough {
+            base_color,
+            metallic,
+            roughness,
+        } => Material::MetalRough {
+            base_color: build_texture(base_color, span, "base_color")?,
+            metallic: build_texture(metallic, span, "metallic")?,
+            roughness: build_texture(roughness, span, "roughness")?,
+        },
+        BsdfDesc::TwoSided(inner) => build_material(inner, span)?,
+        BsdfDesc::NormalMap { map, inner } => Material::NormalMap {
+            map: build_texture(map, span, "normal_map")?,
+            inner: Box::new(build_material(inner, span)?),
         },
     })
 }

@@ -9,7 +9,7 @@
 use std::fmt;
 use std::sync::Arc;
 
-use glam::{Mat4, Vec2, Vec3};
+use glam::{Affine2, Mat4, Vec2, Vec3};
 
 /// Where an item of a description came from: `file:line:col` (1-based). Items made in code
 /// have an empty file name and line 0.
@@ -149,17 +149,107 @@ pub struct MaterialDesc {
     pub span: Span,
 }
 
-/// The scattering model of a material.
+/// The scattering model of a material. Roughnesses are GGX α (α = perceptual
+/// roughness²); α below 10⁻³ makes a smooth (delta) interface. `eta` is the relative
+/// index of refraction, inside over outside.
 #[derive(Clone, Debug)]
 pub enum BsdfDesc {
     /// Lambertian reflection with the given albedo.
     Diffuse { albedo: TextureDesc },
+    /// A metal with complex index η + ik per channel (see
+    /// [`crate::bsdf::metal_preset`] for named metals); α along the tangent and bitangent.
+    Conductor {
+        eta: Vec3,
+        k: Vec3,
+        alpha_u: f32,
+        alpha_v: f32,
+    },
+    /// Glass-like interface; `thin` makes a thin sheet (no net refraction, smooth only).
+    Dielectric {
+        eta: f32,
+        alpha_u: f32,
+        alpha_v: f32,
+        thin: bool,
+    },
+    /// A diffuse base under a smooth dielectric coat of index `eta`.
+    Plastic { albedo: TextureDesc, eta: f32 },
+    /// glTF 2.0 metallic-roughness: metallic and roughness read the texture's first
+    /// channel (or the one an image texture selects) and lie in [0, 1].
+    MetalRough {
+        base_color: TextureDesc,
+        metallic: TextureDesc,
+        roughness: TextureDesc,
+    },
+    /// The same BSDF on both sides. Candela's reflective BSDFs already are two-sided, so
+    /// this records the intent of imported scenes (Mitsuba `twosided`, glTF
+    /// `doubleSided`) and builds the inner BSDF.
+    TwoSided(Box<BsdfDesc>),
+    /// Bends the shading normal by a tangent-space normal map (glTF convention: RGB =
+    /// (x, y, z)·0.5 + 0.5, x along +u, y along +v, linear data).
+    NormalMap {
+        map: TextureDesc,
+        inner: Box<BsdfDesc>,
+    },
 }
 
-/// A colour that may vary over a surface. Values are linear.
+/// A colour (or, read through one channel, a scalar) that may vary over a surface.
+/// Values are linear.
 #[derive(Clone, Debug)]
 pub enum TextureDesc {
     Constant(Vec3),
+    Image(ImageTextureDesc),
+    /// Alternating squares of `a` and `b`, one per unit of the transformed uv.
+    Checker {
+        a: Vec3,
+        b: Vec3,
+        uv_transform: Affine2,
+    },
+}
+
+/// A decoded image: linear values, rows from the top, `width·height` pixels. Loaders do
+/// the decoding (sRGB EOTF for colour images, none for data images).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct ImageDesc {
+    pub width: u32,
+    pub height: u32,
+    pub pixels: Vec<Vec3>,
+}
+
+/// How texture coordinates outside [0, 1] are brought back.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum WrapMode {
+    #[default]
+    Repeat,
+    Clamp,
+    Mirror,
+}
+
+/// An image placed on a surface. The uv (0, 0) is the image's bottom-left corner
+/// (OpenGL, pbrt and Mitsuba; glTF loaders flip v). Filtering is bilinear.
+#[derive(Clone, Debug)]
+pub struct ImageTextureDesc {
+    pub image: Arc<ImageDesc>,
+    pub wrap: WrapMode,
+    /// Applied to the uv before the lookup.
+    pub uv_transform: Affine2,
+    /// Multiplies the looked-up value (glTF's factors).
+    pub scale: Vec3,
+    /// Reads one channel (0, 1, 2) into all three, e.g. glTF roughness (1) and metallic
+    /// (2) from one packed image.
+    pub channel: Option<u8>,
+}
+
+impl ImageTextureDesc {
+    /// An image with repeat wrapping, no transform, no scale, all channels.
+    pub fn new(image: Arc<ImageDesc>) -> ImageTextureDesc {
+        ImageTextureDesc {
+            image,
+            wrap: WrapMode::Repeat,
+            uv_transform: Affine2::IDENTITY,
+            scale: Vec3::ONE,
+            channel: None,
+        }
+    }
 }
 
 /// A shape, its material, its emission and its placement.

@@ -45,5 +45,6 @@ pub mod photometry;
 pub mod sampler;
 pub mod sampling;
 pub mod scene;
+pub mod texture;
 
 pub use scene::Scene;

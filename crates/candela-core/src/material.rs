@@ -2,43 +2,131 @@
 
 use glam::{Vec2, Vec3};
 
-use crate::bsdf::{Bsdf, Diffuse, Lobe};
+use crate::bsdf::{Bsdf, Diffuse, Lobe, MetalRough, Plastic};
+use crate::math::Frame;
+pub use crate::texture::Texture;
 
 /// Index of a material in [`crate::Scene::materials`].
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub struct MaterialId(pub u32);
 
-/// A colour that may vary over a surface (linear values).
-#[derive(Clone, Debug)]
-pub enum Texture {
-    Constant(Vec3),
-}
-
-impl Texture {
-    pub fn eval(&self, _uv: Vec2) -> Vec3 {
-        match self {
-            Texture::Constant(c) => *c,
-        }
-    }
-}
-
+/// A material: textures to look up, and the lobe they parameterize.
 #[derive(Clone, Debug)]
 pub enum Material {
-    Diffuse { albedo: Texture },
+    Diffuse {
+        albedo: Texture,
+    },
+    /// Lobes with no textured parameter, ready made at build time.
+    Fixed(Lobe),
+    Plastic {
+        albedo: Texture,
+        /// A template holding η and F_dr (computed once); the albedo is replaced.
+        coat: Plastic,
+    },
+    MetalRough {
+        base_color: Texture,
+        metallic: Texture,
+        roughness: Texture,
+    },
+    /// Bends the shading normal by a tangent-space normal map before the inner material.
+    NormalMap {
+        map: Texture,
+        inner: Box<Material>,
+    },
 }
 
 impl Material {
     /// The BSDF at a point with shading normal `ns`, geometric normal `ng` and texture
-    /// coordinates `uv`.
+    /// coordinates `uv`, with the tangent taken from the shading frame (so a normal map's
+    /// orientation is arbitrary; see [`Material::bsdf_with_tangent`]).
     pub fn bsdf(&self, ns: Vec3, ng: Vec3, uv: Vec2) -> Bsdf {
+        self.bsdf_with_tangent(ns, ng, uv, Frame::from_z(ns).s)
+    }
+
+    /// The BSDF with `dpdu` (the surface's ∂p/∂u) giving the tangent of the shading frame.
+    pub fn bsdf_with_tangent(&self, ns: Vec3, ng: Vec3, uv: Vec2, dpdu: Vec3) -> Bsdf {
         match self {
-            Material::Diffuse { albedo } => Bsdf::new(
-                ns,
-                ng,
-                Lobe::Diffuse(Diffuse {
-                    albedo: albedo.eval(uv),
-                }),
-            ),
+            Material::NormalMap { map, inner } => {
+                let n = normal_mapped(ns, ng, dpdu, map.eval(uv));
+                inner.bsdf_with_tangent(n, ng, uv, dpdu)
+            }
+            _ => Bsdf::with_tangent(ns, ng, dpdu, self.lobe(uv)),
+        }
+    }
+
+    fn lobe(&self, uv: Vec2) -> Lobe {
+        match self {
+            Material::Diffuse { albedo } => Lobe::Diffuse(Diffuse {
+                albedo: albedo.eval(uv),
+            }),
+            Material::Fixed(lobe) => *lobe,
+            Material::Plastic { albedo, coat } => Lobe::Plastic(Plastic {
+                albedo: albedo.eval(uv).min(Vec3::ONE),
+                ..*coat
+            }),
+            Material::MetalRough {
+                base_color,
+                metallic,
+                roughness,
+            } => Lobe::MetalRough(MetalRough::new(
+                base_color.eval(uv),
+                metallic.eval_scalar(uv),
+                roughness.eval_scalar(uv),
+            )),
+            Material::NormalMap { inner, .. } => inner.lobe(uv),
+        }
+    }
+}
+
+/// The shading normal a tangent-space normal map asks for, decoded as glTF stores it
+/// (c·2 − 1). Never NaN, and never more than ~84° from the geometric normal's side: a
+/// degenerate map value or one that would face away from the surface falls back to `ns`,
+/// so the reflection/transmission test against `ng` stays meaningful.
+pub fn normal_mapped(ns: Vec3, ng: Vec3, dpdu: Vec3, texel: Vec3) -> Vec3 {
+    let m = texel * 2.0 - Vec3::ONE;
+    let t = (dpdu - ns * ns.dot(dpdu)).normalize_or_zero();
+    let t = if t == Vec3::ZERO {
+        Frame::from_z(ns).s
+    } else {
+        t
+    };
+    let b = ns.cross(t);
+    let n = (t * m.x + b * m.y + ns * m.z).normalize_or_zero();
+    let ng = if ng.dot(ns) < 0.0 { -ng } else { ng };
+    if !n.is_finite() || n.dot(ng) < 0.1 {
+        ns
+    } else {
+        n
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn normal_map_follows_the_tangent_and_never_faces_away() {
+        let (ns, ng, dpdu) = (Vec3::Z, Vec3::Z, Vec3::X);
+        // The flat texel (0.5, 0.5, 1) keeps the normal.
+        let flat = normal_mapped(ns, ng, dpdu, Vec3::new(0.5, 0.5, 1.0));
+        assert!((flat - Vec3::Z).length() < 1e-6);
+        // Tilted towards +u.
+        let n = normal_mapped(ns, ng, dpdu, Vec3::new(0.85, 0.5, 0.85));
+        assert!(
+            n.x > 0.3 && n.y.abs() < 1e-6 && (n.length() - 1.0).abs() < 1e-5,
+            "{n}"
+        );
+        // Degenerate or back-facing texels and tangents fall back to the shading normal.
+        for texel in [
+            Vec3::splat(0.5),
+            Vec3::new(0.5, 0.5, 0.0),
+            Vec3::new(1.0, 0.5, 0.5),
+            Vec3::NAN,
+        ] {
+            for t in [Vec3::X, Vec3::ZERO, Vec3::Z, Vec3::NAN] {
+                let n = normal_mapped(ns, ng, t, texel);
+                assert!(n.is_finite() && n.dot(ng) >= 0.1, "{texel} {t}: {n}");
+            }
         }
     }
 }

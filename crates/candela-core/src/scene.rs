@@ -86,6 +86,9 @@ pub struct SurfaceInteraction {
     /// Unit shading normal, on the same side as `ng`.
     pub ns: Vec3,
     pub uv: Vec2,
+    /// ∂p/∂u, the direction of increasing u (zero where the uvs are degenerate): the
+    /// tangent of normal maps and anisotropic roughness.
+    pub dpdu: Vec3,
     pub material: MaterialId,
     pub light: Option<LightId>,
 }
@@ -233,12 +236,18 @@ impl Scene {
                     m.uvs[a] * b0 + m.uvs[b] * bary.x + m.uvs[c] * bary.y
                 };
                 let light = m.lights.get(tri as usize).copied();
+                let dpdu = if m.uvs.is_empty() {
+                    p1 - p0
+                } else {
+                    triangle_dpdu([p0, p1, p2], [m.uvs[a], m.uvs[b], m.uvs[c]])
+                };
                 SurfaceInteraction {
                     p,
                     t,
                     ng,
                     ns,
                     uv,
+                    dpdu,
                     material: m.material,
                     light,
                 }
@@ -260,10 +269,29 @@ impl Scene {
                     ng: n,
                     ns: n,
                     uv,
+                    // u grows with φ = atan2(z, x): along (−z, 0, x) of the normal.
+                    dpdu: Vec3::new(-n_out.z, 0.0, n_out.x),
                     material: s.material,
                     light: s.light,
                 }
             }
         }
+    }
+}
+
+/// ∂p/∂u of a triangle from its positions and uvs (pbrt-v4 §6.5.3); zero when the uvs
+/// are degenerate.
+fn triangle_dpdu(p: [Vec3; 3], uv: [Vec2; 3]) -> Vec3 {
+    let (duv02, duv12) = (uv[0] - uv[2], uv[1] - uv[2]);
+    let (dp02, dp12) = (p[0] - p[2], p[1] - p[2]);
+    let det = duv02.x * duv12.y - duv02.y * duv12.x;
+    if det.abs() < 1e-12 {
+        return Vec3::ZERO;
+    }
+    let dpdu = (duv12.y * dp02 - duv02.y * dp12) / det;
+    if dpdu.is_finite() {
+        dpdu
+    } else {
+        Vec3::ZERO
     }
 }

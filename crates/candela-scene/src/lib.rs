@@ -32,9 +32,11 @@ use std::sync::Arc;
 
 use candela_core::desc::{MeshDesc, SceneDesc, Span};
 
+pub mod image_texture;
 pub mod obj;
 pub mod ply;
 mod toml_camera;
+mod toml_material;
 pub mod toml_scene;
 mod toml_shape;
 mod toml_values;

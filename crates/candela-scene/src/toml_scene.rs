@@ -10,16 +10,15 @@
 use std::path::Path;
 
 use candela_core::desc::{
-    BsdfDesc, LightDesc, LightKindDesc, LightSamplerKind, MaterialDesc, MisMode, RenderSettings,
-    SceneDesc, TextureDesc,
+    LightDesc, LightKindDesc, LightSamplerKind, MaterialDesc, MisMode, RenderSettings, SceneDesc,
 };
-use glam::Vec3;
 use serde::de::{DeserializeOwned, IgnoredAny};
 use serde::Deserialize;
 use toml::de::{DeTable, DeValue, ValueDeserializer};
 use toml::Spanned;
 
 use crate::toml_camera::parse_camera;
+use crate::toml_material::{parse_material, MATERIAL_TYPES};
 use crate::toml_shape::parse_shape;
 use crate::toml_values::{Splat3, V3};
 use crate::{LoadError, Source};
@@ -39,7 +38,7 @@ pub fn parse_toml_scene(text: &str, file: &Path) -> Result<SceneDesc, LoadError>
         match key.get_ref().as_ref() {
             "render" => desc.render = parse_render(&src, value)?,
             "camera" => desc.camera = parse_camera(&src, base, key_at, value)?,
-            "materials" => desc.materials = parse_materials(&src, value)?,
+            "materials" => desc.materials = parse_materials(&src, base, value)?,
             "shape" => {
                 for item in array_of_tables(&src, "shape", value)? {
                     desc.shapes.push(parse_shape(&src, base, item)?);
@@ -197,18 +196,7 @@ fn parse_render(src: &Source, value: Item) -> Result<RenderSettings, LoadError> 
     Ok(out)
 }
 
-#[derive(Deserialize)]
-#[serde(deny_unknown_fields)]
-struct DiffuseEntry {
-    #[serde(rename = "type")]
-    _kind: IgnoredAny,
-    albedo: Option<Splat3>,
-}
-
-/// Albedo of a diffuse material without one (Mitsuba's default).
-const DEFAULT_ALBEDO: f32 = 0.5;
-
-fn parse_materials(src: &Source, value: Item) -> Result<Vec<MaterialDesc>, LoadError> {
+fn parse_materials(src: &Source, base: &Path, value: Item) -> Result<Vec<MaterialDesc>, LoadError> {
     let at = value.span().start;
     let DeValue::Table(table) = value.into_inner() else {
         return Err(src.error(at, "`materials` must be a table of named materials"));
@@ -216,16 +204,8 @@ fn parse_materials(src: &Source, value: Item) -> Result<Vec<MaterialDesc>, LoadE
     let mut out = Vec::new();
     for (name, item) in table {
         let span = src.span(name.span().start);
-        let bsdf = match item_type(src, "material", &item, &["diffuse"])? {
-            "diffuse" => {
-                let m: DiffuseEntry = deserialize(src, item)?;
-                let albedo = m.albedo.map_or(Vec3::splat(DEFAULT_ALBEDO), |c| c.0);
-                BsdfDesc::Diffuse {
-                    albedo: TextureDesc::Constant(albedo),
-                }
-            }
-            _ => unreachable!("item_type checked the type"),
-        };
+        let kind = item_type(src, "material", &item, MATERIAL_TYPES)?;
+        let bsdf = parse_material(src, base, kind, item)?;
         out.push(MaterialDesc {
             name: name.into_inner().into_owned(),
             bsdf,

@@ -9,15 +9,37 @@
 //! - `f(wo, wi)` is the BSDF value alone, **without** the cosine factor |cos θᵢ|; the
 //!   integrator multiplies by it.
 //! - `pdf` is in **solid angle** measure over `wi`. Delta lobes (perfect mirrors and
-//!   refraction) return `pdf = 0` and `f = 0` from `f`/`pdf`; their `sample` returns the
-//!   lobe's weight in `f` with `pdf = 1` and the [`BsdfFlags::DELTA`] flag, so that MIS
-//!   never weights them.
+//!   refraction) return `pdf = 0` and `f = 0` from `f`/`pdf`; their `sample` returns
+//!   `pdf = 1` and the [`BsdfFlags::DELTA`] flag, so that MIS never weights them.
 //! - `sample(wo, u_lobe, u_dir)` returns `f`, `wi`, `pdf` such that `f · |cos θᵢ| / pdf`
-//!   is the sample's weight.
+//!   is the sample's weight. For a delta sample `f` is that weight divided by |cos θᵢ|.
+//! - Reflection-only lobes are two-sided: seen from below (`wo.z < 0`) they behave as seen
+//!   from above, mirrored (so [`BsdfDesc::TwoSided`](crate::desc::BsdfDesc::TwoSided) only
+//!   records intent, e.g. from an imported scene). Reflection means `wo.z·wi.z > 0`.
+//! - Transmission: a dielectric's `eta` is η_inside/η_outside, the outside being the side
+//!   the shading normal points to. Transmitted radiance is scaled by 1/η'² (η' = η_t/η_i
+//!   of the crossing), because Candela traces camera paths only (Veach 1997, §5.2); a thin
+//!   sheet has no net refraction and no scaling.
+//! - Light leaks: [`Bsdf`] decides between reflection and transmission with the
+//!   **geometric** normal. A pair of directions that is a reflection for the shading
+//!   normal but a transmission for the geometric one (or the other way round) gets f = 0,
+//!   pdf = 0, and such sampled directions are rejected (pbrt-v3 §9.1's rule), so light
+//!   never leaks through a surface because its shading normal is bent.
 
+mod conductor;
+mod dielectric;
 mod diffuse;
+pub mod fresnel;
+mod metal_rough;
+pub mod microfacet;
+mod plastic;
 
+pub use conductor::{metal_preset, Conductor, ConductorFresnel, METAL_PRESETS};
+pub use dielectric::{Dielectric, ThinDielectric};
 pub use diffuse::Diffuse;
+pub use metal_rough::MetalRough;
+pub use microfacet::TrowbridgeReitz;
+pub use plastic::Plastic;
 
 use glam::{Vec2, Vec3};
 
@@ -50,7 +72,7 @@ impl BsdfFlags {
 /// A sampled scattering direction.
 #[derive(Clone, Copy, Debug)]
 pub struct BsdfSample {
-    /// BSDF value (no cosine), or the delta lobe's weight.
+    /// BSDF value (no cosine), or the delta lobe's weight divided by |cos θᵢ|.
     pub f: Vec3,
     pub wi: Vec3,
     /// Solid-angle density of `wi` (1 for delta lobes).
@@ -62,31 +84,89 @@ pub struct BsdfSample {
 #[derive(Clone, Copy, Debug)]
 pub enum Lobe {
     Diffuse(Diffuse),
+    Conductor(Conductor),
+    Dielectric(Dielectric),
+    ThinDielectric(ThinDielectric),
+    Plastic(Plastic),
+    MetalRough(MetalRough),
+}
+
+/// Mirrors a direction through the surface plane (z → −z).
+fn flip_z(w: Vec3) -> Vec3 {
+    Vec3::new(w.x, w.y, -w.z)
 }
 
 impl Lobe {
-    pub fn f(&self, wo: Vec3, wi: Vec3) -> Vec3 {
+    /// Reflection-only lobes, evaluated in the hemisphere of `wo` (two-sided).
+    fn reflective_f(&self, wo: Vec3, wi: Vec3) -> Vec3 {
         match self {
             Lobe::Diffuse(l) => l.f(wo, wi),
+            Lobe::Conductor(l) => l.f(wo, wi),
+            Lobe::Plastic(l) => l.f(wo, wi),
+            Lobe::MetalRough(l) => l.f(wo, wi),
+            Lobe::Dielectric(_) | Lobe::ThinDielectric(_) => Vec3::ZERO,
+        }
+    }
+
+    pub fn f(&self, wo: Vec3, wi: Vec3) -> Vec3 {
+        match self {
+            Lobe::Dielectric(l) => l.f(wo, wi),
+            Lobe::ThinDielectric(_) => Vec3::ZERO,
+            _ if wo.z < 0.0 => self.reflective_f(flip_z(wo), flip_z(wi)),
+            _ => self.reflective_f(wo, wi),
         }
     }
 
     pub fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
+        let (wo, wi) = if wo.z < 0.0 && self.is_reflective() {
+            (flip_z(wo), flip_z(wi))
+        } else {
+            (wo, wi)
+        };
         match self {
             Lobe::Diffuse(l) => l.pdf(wo, wi),
+            Lobe::Conductor(l) => l.pdf(wo, wi),
+            Lobe::Plastic(l) => l.pdf(wo, wi),
+            Lobe::MetalRough(l) => l.pdf(wo, wi),
+            Lobe::Dielectric(l) => l.pdf(wo, wi),
+            Lobe::ThinDielectric(_) => 0.0,
         }
     }
 
     pub fn sample(&self, wo: Vec3, u_lobe: f32, u: Vec2) -> Option<BsdfSample> {
-        match self {
+        let flip = wo.z < 0.0 && self.is_reflective();
+        let wo = if flip { flip_z(wo) } else { wo };
+        let s = match self {
             Lobe::Diffuse(l) => l.sample(wo, u_lobe, u),
-        }
+            Lobe::Conductor(l) => l.sample(wo, u),
+            Lobe::Plastic(l) => l.sample(wo, u_lobe, u),
+            Lobe::MetalRough(l) => l.sample(wo, u_lobe, u),
+            Lobe::Dielectric(l) => l.sample(wo, u_lobe, u),
+            Lobe::ThinDielectric(l) => l.sample(wo, u_lobe),
+        }?;
+        Some(if flip {
+            BsdfSample {
+                wi: flip_z(s.wi),
+                ..s
+            }
+        } else {
+            s
+        })
     }
 
-    /// Whether every component is a delta (then NEE is pointless).
+    fn is_reflective(&self) -> bool {
+        !matches!(self, Lobe::Dielectric(_) | Lobe::ThinDielectric(_))
+    }
+
+    /// Whether every component is a delta (then NEE is pointless). Plastic is not: its
+    /// coat is a delta but its base is diffuse, and NEE goes through `f`/`pdf`, which
+    /// hold only the diffuse part.
     pub fn is_delta(&self) -> bool {
         match self {
-            Lobe::Diffuse(_) => false,
+            Lobe::Diffuse(_) | Lobe::Plastic(_) | Lobe::MetalRough(_) => false,
+            Lobe::Conductor(l) => l.is_delta(),
+            Lobe::Dielectric(l) => l.is_delta(),
+            Lobe::ThinDielectric(_) => true,
         }
     }
 }
@@ -110,9 +190,36 @@ impl Bsdf {
         }
     }
 
+    /// A BSDF whose frame's first axis (the direction of `alpha_u`) follows the surface
+    /// tangent `dpdu`, made orthogonal to `ns`; falls back to [`Bsdf::new`] when `dpdu`
+    /// is zero or parallel to `ns`.
+    pub fn with_tangent(ns: Vec3, ng: Vec3, dpdu: Vec3, lobe: Lobe) -> Bsdf {
+        let s = (dpdu - ns * ns.dot(dpdu)).normalize_or_zero();
+        if s == Vec3::ZERO || !s.is_finite() {
+            return Bsdf::new(ns, ng, lobe);
+        }
+        Bsdf {
+            frame: Frame {
+                s,
+                t: ns.cross(s),
+                n: ns,
+            },
+            ng,
+            lobe,
+        }
+    }
+
+    /// Whether the geometric normal agrees with the shading frame on reflection versus
+    /// transmission for this pair (see the module's conventions on light leaks).
+    fn sides_agree(&self, wo: Vec3, wi: Vec3, lo: Vec3, li: Vec3) -> bool {
+        let geometric_reflection = wo.dot(self.ng) * wi.dot(self.ng) > 0.0;
+        let shading_reflection = lo.z * li.z > 0.0;
+        geometric_reflection == shading_reflection
+    }
+
     pub fn f(&self, wo: Vec3, wi: Vec3) -> Vec3 {
         let (lo, li) = (self.frame.to_local(wo), self.frame.to_local(wi));
-        if lo.z == 0.0 {
+        if lo.z == 0.0 || !self.sides_agree(wo, wi, lo, li) {
             return Vec3::ZERO;
         }
         self.lobe.f(lo, li)
@@ -120,7 +227,7 @@ impl Bsdf {
 
     pub fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
         let (lo, li) = (self.frame.to_local(wo), self.frame.to_local(wi));
-        if lo.z == 0.0 {
+        if lo.z == 0.0 || !self.sides_agree(wo, wi, lo, li) {
             return 0.0;
         }
         self.lobe.pdf(lo, li)
@@ -132,13 +239,14 @@ impl Bsdf {
             return None;
         }
         let s = self.lobe.sample(lo, u_lobe, u)?;
-        if s.pdf == 0.0 || !s.pdf.is_finite() || s.wi.z == 0.0 {
+        if s.pdf == 0.0 || !s.pdf.is_finite() || s.wi.z == 0.0 || !s.f.is_finite() {
             return None;
         }
-        Some(BsdfSample {
-            wi: self.frame.to_world(s.wi),
-            ..s
-        })
+        let wi = self.frame.to_world(s.wi);
+        if !self.sides_agree(wo, wi, lo, s.wi) {
+            return None;
+        }
+        Some(BsdfSample { wi, ..s })
     }
 
     pub fn is_delta(&self) -> bool {

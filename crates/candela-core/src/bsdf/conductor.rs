@@ -1,0 +1,153 @@
+//! Metals: smooth (a perfect mirror) or rough (GGX microfacets), with the complex Fresnel
+//! reflectance of a conductor per RGB channel.
+
+use glam::{Vec2, Vec3};
+
+use super::fresnel::{fresnel_conductor, fresnel_schlick, reflect};
+use super::microfacet::TrowbridgeReitz;
+use super::{BsdfFlags, BsdfSample};
+
+/// How a conductor's reflectance depends on the angle.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum ConductorFresnel {
+    /// Complex index of refraction η + ik per channel, relative to the outside medium.
+    Complex { eta: Vec3, k: Vec3 },
+    /// Schlick's approximation from the normal-incidence reflectance F₀ (glTF metals;
+    /// F₀ = 1 gives the ideal white conductor of the furnace test).
+    Schlick { f0: Vec3 },
+}
+
+impl ConductorFresnel {
+    pub fn eval(&self, cos_i: f32) -> Vec3 {
+        match *self {
+            ConductorFresnel::Complex { eta, k } => fresnel_conductor(cos_i, eta, k),
+            ConductorFresnel::Schlick { f0 } => fresnel_schlick(f0, cos_i),
+        }
+    }
+}
+
+/// A conductor: a delta mirror when the distribution is [effectively
+/// smooth](TrowbridgeReitz::effectively_smooth), otherwise the Torrance–Sparrow GGX BRDF
+/// D·G·F/(4 cos θo cos θi) sampled by visible normals (pbrt-v4 §9.6.4). Reflection only;
+/// `wo` must lie in the upper hemisphere (the [`super::Lobe`] mirrors the back side).
+#[derive(Clone, Copy, Debug)]
+pub struct Conductor {
+    pub distrib: TrowbridgeReitz,
+    pub fresnel: ConductorFresnel,
+}
+
+impl Conductor {
+    pub fn is_delta(&self) -> bool {
+        self.distrib.effectively_smooth()
+    }
+
+    pub fn f(&self, wo: Vec3, wi: Vec3) -> Vec3 {
+        if self.is_delta() || wo.z <= 0.0 || wi.z <= 0.0 {
+            return Vec3::ZERO;
+        }
+        let wm = (wo + wi).normalize_or_zero();
+        if wm == Vec3::ZERO {
+            return Vec3::ZERO;
+        }
+        let d = self.distrib.d(wm);
+        let g = self.distrib.g(wo, wi);
+        self.fresnel.eval(wo.dot(wm)) * (d * g / (4.0 * wo.z * wi.z))
+    }
+
+    pub fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
+        if self.is_delta() || wo.z <= 0.0 || wi.z <= 0.0 {
+            return 0.0;
+        }
+        let wm = (wo + wi).normalize_or_zero();
+        if wm == Vec3::ZERO {
+            return 0.0;
+        }
+        // Jacobian of the reflection map: dωm/dωi = 1/(4 |ωo·ωm|).
+        self.distrib.d_visible(wo, wm) / (4.0 * wo.dot(wm).abs())
+    }
+
+    pub fn sample(&self, wo: Vec3, u: Vec2) -> Option<BsdfSample> {
+        if wo.z <= 0.0 {
+            return None;
+        }
+        if self.is_delta() {
+            let wi = Vec3::new(-wo.x, -wo.y, wo.z);
+            return Some(BsdfSample {
+                f: self.fresnel.eval(wi.z) / wi.z,
+                wi,
+                pdf: 1.0,
+                flags: BsdfFlags::REFLECTION.union(BsdfFlags::DELTA),
+            });
+        }
+        let wm = self.distrib.sample_wm(wo, u);
+        let wi = reflect(wo, wm);
+        if wi.z <= 0.0 {
+            return None;
+        }
+        let pdf = self.pdf(wo, wi);
+        (pdf > 0.0).then(|| BsdfSample {
+            f: self.f(wo, wi),
+            wi,
+            pdf,
+            flags: BsdfFlags::REFLECTION.union(BsdfFlags::GLOSSY),
+        })
+    }
+}
+
+/// Named metals: (name, η, k) in linear Rec.709 RGB, relative to air. These are the RGB
+/// reductions of measured spectral data that Tungsten tabulates (`ComplexIorData.hpp`,
+/// from the spectra Mitsuba 0.5 ships, after Palik's *Handbook of Optical Constants of
+/// Solids*); the spectral curves were reduced to RGB once, by their tables' authors.
+pub const METAL_PRESETS: [(&str, [f32; 3], [f32; 3]); 5] = [
+    (
+        "Au",
+        [0.143119, 0.374957, 1.44248],
+        [3.98316, 2.38572, 1.60322],
+    ),
+    (
+        "Ag",
+        [0.155265, 0.116723, 0.138342],
+        [4.82835, 3.12225, 2.14696],
+    ),
+    (
+        "Cu",
+        [0.200438, 0.924033, 1.10221],
+        [3.91295, 2.45285, 2.14219],
+    ),
+    (
+        "Al",
+        [1.65746, 0.880369, 0.521229],
+        [9.22387, 6.26952, 4.837],
+    ),
+    ("Cr", [4.36968, 2.9167, 1.6547], [5.20643, 4.23136, 3.75495]),
+];
+
+/// The (η, k) of a named metal from [`METAL_PRESETS`] (case-insensitive), for loaders.
+pub fn metal_preset(name: &str) -> Option<(Vec3, Vec3)> {
+    METAL_PRESETS
+        .iter()
+        .find(|(n, _, _)| n.eq_ignore_ascii_case(name))
+        .map(|(_, eta, k)| (Vec3::from(*eta), Vec3::from(*k)))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn presets_have_their_metals_colours() {
+        let r0 = |name| {
+            let (eta, k) = metal_preset(name).unwrap();
+            fresnel_conductor(1.0, eta, k)
+        };
+        let (au, ag, cu, al) = (r0("au"), r0("Ag"), r0("Cu"), r0("Al"));
+        assert!(
+            au.x > au.y && au.y > au.z && au.z < 0.5,
+            "gold is yellow: {au}"
+        );
+        assert!(cu.x > cu.y && cu.x > cu.z, "copper is red: {cu}");
+        assert!(ag.min_element() > 0.9, "silver is bright and grey: {ag}");
+        assert!(al.min_element() > 0.85, "aluminium is bright: {al}");
+        assert!(metal_preset("unobtainium").is_none());
+    }
+}

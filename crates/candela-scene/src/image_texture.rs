@@ -1,0 +1,162 @@
+//! Image textures: PNG, JPEG, TGA and BMP through `image`, Radiance HDR through `image`,
+//! OpenEXR through `exr`, decoded once to linear RGB ([`ImageDesc`]).
+//!
+//! Integer images are encoded: a colour texture is decoded with the exact sRGB EOTF
+//! (IEC 61966-2-1, [`srgb_decode`]) unless the scene asks for a pure power law
+//! (`gamma = 2.2`); data textures (roughness, metallic, normal maps) are linear. Float
+//! images (EXR, HDR) are linear already and never decoded. Alpha is dropped.
+
+use std::path::Path;
+
+use candela_core::color::srgb_decode;
+use candela_core::desc::ImageDesc;
+use glam::Vec3;
+
+/// How an integer image's values map to linear ones.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Encoding {
+    /// The sRGB transfer function (colour textures by default).
+    Srgb,
+    /// value^γ (γ = 1: linear data).
+    Gamma(f32),
+}
+
+impl Encoding {
+    /// Linear value of an encoded one in [0, 1].
+    pub fn decode(self, v: f32) -> f32 {
+        match self {
+            Encoding::Srgb => srgb_decode(v),
+            Encoding::Gamma(1.0) => v,
+            Encoding::Gamma(g) => v.max(0.0).powf(g),
+        }
+    }
+}
+
+/// Loads an image file as linear RGB, choosing the decoder by extension. Errors name the
+/// file and the reason.
+pub fn load_image(path: &Path, encoding: Encoding) -> Result<ImageDesc, String> {
+    let ext = path
+        .extension()
+        .map(|e| e.to_string_lossy().to_ascii_lowercase())
+        .unwrap_or_default();
+    let fail = |e: &dyn std::fmt::Display| format!("{}: cannot read image: {e}", path.display());
+    match ext.as_str() {
+        "exr" => load_exr(path).map_err(|e| fail(&e)),
+        "png" | "jpg" | "jpeg" | "tga" | "bmp" | "hdr" => {
+            let img = image::open(path).map_err(|e| fail(&e))?;
+            Ok(from_dynamic(&img, encoding))
+        }
+        _ => Err(format!(
+            "{}: unsupported image format \".{ext}\"; supported: .png, .jpg, .jpeg, .tga, \
+             .bmp, .hdr, .exr",
+            path.display()
+        )),
+    }
+}
+
+/// Converts a decoded image to linear RGB: float images as they are, integer ones
+/// through `encoding`.
+pub fn from_dynamic(img: &image::DynamicImage, encoding: Encoding) -> ImageDesc {
+    let is_float = matches!(
+        img,
+        image::DynamicImage::ImageRgb32F(_) | image::DynamicImage::ImageRgba32F(_)
+    );
+    let rgb = img.to_rgb32f();
+    let decode = |v: f32| if is_float { v } else { encoding.decode(v) };
+    ImageDesc {
+        width: rgb.width(),
+        height: rgb.height(),
+        pixels: rgb
+            .pixels()
+            .map(|p| Vec3::new(decode(p[0]), decode(p[1]), decode(p[2])))
+            .collect(),
+    }
+}
+
+fn load_exr(path: &Path) -> Result<ImageDesc, exr::error::Error> {
+    use exr::prelude::*;
+    let image = read_first_rgba_layer_from_file(
+        path,
+        |res, _| ImageDesc {
+            width: res.width() as u32,
+            height: res.height() as u32,
+            pixels: vec![Vec3::ZERO; res.width() * res.height()],
+        },
+        |img: &mut ImageDesc, pos, (r, g, b, _a): (f32, f32, f32, f32)| {
+            let w = img.width as usize;
+            img.pixels[pos.y() * w + pos.x()] = Vec3::new(r, g, b);
+        },
+    )?;
+    Ok(image.layer_data.channel_data.pixels)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use candela_core::color::{srgb_encode, to_u8};
+
+    #[test]
+    fn srgb_128_loads_as_0_2158_and_gamma_2_2_differs() {
+        let img = image::DynamicImage::ImageRgb8(image::RgbImage::from_pixel(
+            1,
+            1,
+            image::Rgb([128, 0, 255]),
+        ));
+        let lin = from_dynamic(&img, Encoding::Srgb).pixels[0];
+        assert!((lin.x - 0.2158).abs() < 1e-4, "{lin}");
+        assert_eq!((lin.y, lin.z), (0.0, 1.0));
+        let g = from_dynamic(&img, Encoding::Gamma(2.2)).pixels[0].x;
+        assert!((g - (128.0f32 / 255.0).powf(2.2)).abs() < 1e-6 && (g - 0.2158).abs() > 1e-3);
+        assert!(
+            (from_dynamic(&img, Encoding::Gamma(1.0)).pixels[0].x - 128.0 / 255.0).abs() < 1e-7
+        );
+    }
+
+    #[test]
+    fn all_256_values_round_trip_through_load_and_write() {
+        let row = image::RgbImage::from_fn(256, 1, |x, _| image::Rgb([x as u8; 3]));
+        let lin = from_dynamic(&image::DynamicImage::ImageRgb8(row), Encoding::Srgb);
+        for (v, p) in lin.pixels.iter().enumerate() {
+            assert_eq!(to_u8(srgb_encode(p.x)) as usize, v);
+        }
+    }
+
+    #[test]
+    fn files_of_every_format_load() {
+        let dir = tempfile::tempdir().unwrap();
+        let rgb = image::RgbImage::from_fn(3, 2, |x, y| {
+            image::Rgb([(x * 100) as u8, (y * 200) as u8, 64])
+        });
+        for ext in ["png", "tga", "bmp"] {
+            let p = dir.path().join(format!("t.{ext}"));
+            rgb.save(&p).unwrap();
+            let img = load_image(&p, Encoding::Gamma(1.0)).unwrap();
+            assert_eq!((img.width, img.height), (3, 2), "{ext}");
+            assert!(
+                (img.pixels[2].x - 200.0 / 255.0).abs() < 1e-6,
+                "{ext}: row-major from the top"
+            );
+            assert!((img.pixels[3].y - 200.0 / 255.0).abs() < 1e-6, "{ext}");
+        }
+        // Float formats stay linear whatever the encoding asks.
+        let hdr =
+            image::Rgb32FImage::from_fn(2, 1, |x, _| image::Rgb([x as f32 * 4.0 + 0.5, 0.25, 1.0]));
+        let p = dir.path().join("t.hdr");
+        image::DynamicImage::ImageRgb32F(hdr).save(&p).unwrap();
+        let img = load_image(&p, Encoding::Srgb).unwrap();
+        assert!((img.pixels[1].x - 4.5).abs() < 0.05, "{:?}", img.pixels);
+        let p = dir.path().join("t.exr");
+        exr::prelude::write_rgb_file(&p, 2, 1, |x, _| (x as f32 * 3.0 + 0.5, 0.25f32, 2.0f32))
+            .unwrap();
+        let img = load_image(&p, Encoding::Srgb).unwrap();
+        assert_eq!(img.pixels[1], Vec3::new(3.5, 0.25, 2.0));
+        // Errors name the file.
+        let e = load_image(&dir.path().join("nope.png"), Encoding::Srgb).unwrap_err();
+        assert!(e.contains("nope.png"), "{e}");
+        assert!(load_image(&dir.path().join("a.gif"), Encoding::Srgb)
+            .unwrap_err()
+            .contains("unsupported"));
+        std::fs::write(dir.path().join("bad.png"), b"not a png").unwrap();
+        assert!(load_image(&dir.path().join("bad.png"), Encoding::Srgb).is_err());
+    }
+}

@@ -1,0 +1,152 @@
+//! The TOML keys of the material types and their textures, and their errors.
+
+use std::path::Path;
+
+use candela_core::desc::{BsdfDesc, TextureDesc, WrapMode};
+use candela_scene::parse_toml_scene;
+use glam::{Vec2, Vec3};
+
+fn material(body: &str) -> Result<BsdfDesc, String> {
+    material_in(Path::new("scene.toml"), body)
+}
+
+fn material_in(file: &Path, body: &str) -> Result<BsdfDesc, String> {
+    let text = format!("[materials.m]\n{body}\n");
+    parse_toml_scene(&text, file)
+        .map(|d| d.materials[0].bsdf.clone())
+        .map_err(|e| e.to_string())
+}
+
+#[test]
+fn every_material_type_parses() {
+    let BsdfDesc::Conductor {
+        eta,
+        k,
+        alpha_u,
+        alpha_v,
+    } = material("type = \"conductor\"\npreset = \"Au\"\nalpha_u = 0.1\nalpha_v = 0.3").unwrap()
+    else {
+        panic!()
+    };
+    let (au_eta, au_k) = candela_core::bsdf::metal_preset("Au").unwrap();
+    assert_eq!((eta, k, alpha_u, alpha_v), (au_eta, au_k, 0.1, 0.3));
+    let BsdfDesc::Conductor { eta, alpha_u, .. } =
+        material("type = \"conductor\"\neta = [0.2, 0.9, 1.1]\nk = 3\nalpha = 0.05").unwrap()
+    else {
+        panic!()
+    };
+    assert_eq!((eta, alpha_u), (Vec3::new(0.2, 0.9, 1.1), 0.05));
+    assert!(matches!(
+        material("type = \"dielectric\"\neta = 1.33\nthin = true").unwrap(),
+        BsdfDesc::Dielectric { eta, thin: true, alpha_u, .. } if eta == 1.33 && alpha_u == 0.0
+    ));
+    assert!(matches!(
+        material("type = \"plastic\"\nalbedo = [0.1, 0.2, 0.3]").unwrap(),
+        BsdfDesc::Plastic { eta, albedo: TextureDesc::Constant(c) } if eta == 1.5 && c == Vec3::new(0.1, 0.2, 0.3)
+    ));
+    assert!(matches!(
+        material("type = \"metal_rough\"\nbase_color = 0.9\nmetallic = 1\nroughness = 0.4\ntwo_sided = true").unwrap(),
+        BsdfDesc::TwoSided(inner) if matches!(*inner, BsdfDesc::MetalRough { .. })
+    ));
+}
+
+#[test]
+fn textures_parse_and_load_with_the_right_encoding() {
+    let dir = tempfile::tempdir().unwrap();
+    image::RgbImage::from_pixel(2, 2, image::Rgb([128, 128, 128]))
+        .save(dir.path().join("grey.png"))
+        .unwrap();
+    let file = dir.path().join("scene.toml");
+    let body = "type = \"metal_rough\"\n\
+        base_color = { type = \"image\", file = \"grey.png\", wrap = \"mirror\", uv_scale = [2, 3], uv_offset = [0.5, 0], scale = 0.5 }\n\
+        roughness = { type = \"image\", file = \"grey.png\", channel = 1 }\n\
+        metallic = { type = \"image\", file = \"grey.png\", gamma = 2.2 }\n\
+        normal_map = { type = \"image\", file = \"grey.png\" }";
+    let BsdfDesc::NormalMap { map, inner } = material_in(&file, body).unwrap() else {
+        panic!()
+    };
+    let TextureDesc::Image(n) = map else { panic!() };
+    assert!(
+        (n.image.pixels[0].x - 128.0 / 255.0).abs() < 1e-6,
+        "normal maps are linear data"
+    );
+    let BsdfDesc::MetalRough {
+        base_color,
+        metallic,
+        roughness,
+    } = *inner
+    else {
+        panic!()
+    };
+    let TextureDesc::Image(b) = base_color else {
+        panic!()
+    };
+    assert!(
+        (b.image.pixels[0].x - 0.2158).abs() < 1e-4,
+        "colour is sRGB-decoded"
+    );
+    assert_eq!((b.wrap, b.scale), (WrapMode::Mirror, Vec3::splat(0.5)));
+    assert_eq!(
+        b.uv_transform.transform_point2(Vec2::new(1.0, 1.0)),
+        Vec2::new(2.5, 3.0)
+    );
+    let TextureDesc::Image(r) = roughness else {
+        panic!()
+    };
+    assert_eq!(r.channel, Some(1));
+    assert!(
+        (r.image.pixels[0].x - 128.0 / 255.0).abs() < 1e-6,
+        "roughness is linear"
+    );
+    let TextureDesc::Image(m) = metallic else {
+        panic!()
+    };
+    assert!((m.image.pixels[0].x - (128.0f32 / 255.0).powf(2.2)).abs() < 1e-6);
+
+    let TextureDesc::Checker { a, b, uv_transform } = (match material(
+        "type = \"diffuse\"\nalbedo = { type = \"checker\", a = 1, b = [0, 0, 1], uv_scale = [8, 8] }",
+    )
+    .unwrap()
+    {
+        BsdfDesc::Diffuse { albedo } => albedo,
+        _ => panic!(),
+    }) else {
+        panic!()
+    };
+    assert_eq!((a, b), (Vec3::ONE, Vec3::Z));
+    assert_eq!(uv_transform.transform_point2(Vec2::ONE), Vec2::splat(8.0));
+}
+
+#[test]
+fn errors_point_at_the_key() {
+    let cases = [
+        ("type = \"diffuse\"\nalpha = 0.1", "scene.toml:3:1: unknown key `alpha` for a diffuse material"),
+        ("type = \"conductor\"\npreset = \"Unobtainium\"", "scene.toml:3:10: unknown metal preset"),
+        ("type = \"conductor\"\neta = 1", "a conductor takes either `preset` or both `eta` and `k`"),
+        ("type = \"dielectric\"\neta = [1, 2, 3]", "scene.toml:3:7: a dielectric's `eta` is one number"),
+        ("type = \"dielectric\"\neta = -1", "must be positive"),
+        ("type = \"wood\"", "scene.toml:2:8"),
+        ("type = \"diffuse\"\nalbedo = { type = \"image\" }", "scene.toml:3:10: an image texture needs `file`"),
+        ("type = \"diffuse\"\nalbedo = { type = \"image\", file = \"missing.png\" }", "missing.png: cannot read image"),
+        ("type = \"diffuse\"\nalbedo = { type = \"image\", file = \"a.png\", wrap = \"around\" }", "scene.toml:3:"),
+        ("type = \"diffuse\"\nalbedo = { type = \"checker\", file = \"a.png\" }", "does not belong"),
+        ("type = \"diffuse\"\nalbedo = { type = \"checker\", colour = 1 }", "unknown field `colour`"),
+        ("type = \"diffuse\"\nalbedo = \"red\"", "scene.toml:3:10"),
+    ];
+    for (body, want) in cases {
+        let e = material(body).unwrap_err();
+        assert!(e.contains(want), "{body:?}: got {e:?}, want {want:?}");
+    }
+}
+
+#[test]
+fn built_scene_rejects_bad_numbers() {
+    let text = "[materials.m]\ntype = \"conductor\"\npreset = \"Cu\"\nalpha = -0.5\n\
+                [[shape]]\ntype = \"sphere\"\nmaterial = \"m\"\n";
+    let desc = parse_toml_scene(text, Path::new("s.toml")).unwrap();
+    let e = candela_core::build::build(&desc).unwrap_err().to_string();
+    assert!(
+        e.starts_with("s.toml:1:") && e.contains("roughness must not be negative"),
+        "{e}"
+    );
+}
