@@ -10,7 +10,7 @@
 use std::path::Path;
 
 use candela_core::desc::{
-    BsdfDesc, CameraDesc, LightDesc, LightKindDesc, LightSamplerKind, MaterialDesc, MisMode,
+    BsdfDesc, CameraDesc, EmissionProfileDesc, LightSamplerKind, MaterialDesc, MisMode,
     RenderSettings, SceneDesc, TextureDesc,
 };
 use glam::Vec3;
@@ -19,6 +19,7 @@ use serde::Deserialize;
 use toml::de::{DeTable, DeValue, ValueDeserializer};
 use toml::Spanned;
 
+use crate::toml_light::parse_light;
 use crate::toml_shape::parse_shape;
 use crate::toml_values::{Num, Splat3, V3};
 use crate::{LoadError, Source};
@@ -41,12 +42,20 @@ pub fn parse_toml_scene(text: &str, file: &Path) -> Result<SceneDesc, LoadError>
             "materials" => desc.materials = parse_materials(&src, value)?,
             "shape" => {
                 for item in array_of_tables(&src, "shape", value)? {
-                    desc.shapes.push(parse_shape(&src, base, item)?);
+                    let (shape, profile) = parse_shape(&src, base, item)?;
+                    if let Some((table, span)) = profile {
+                        desc.emission_profiles.push(EmissionProfileDesc {
+                            shape: desc.shapes.len(),
+                            table,
+                            span,
+                        });
+                    }
+                    desc.shapes.push(shape);
                 }
             }
             "light" => {
                 for item in array_of_tables(&src, "light", value)? {
-                    desc.lights.push(parse_light(&src, item)?);
+                    desc.lights.push(parse_light(&src, base, item)?);
                 }
             }
             other => {
@@ -249,28 +258,4 @@ fn parse_materials(src: &Source, value: Item) -> Result<Vec<MaterialDesc>, LoadE
         });
     }
     Ok(out)
-}
-
-#[derive(Deserialize)]
-#[serde(deny_unknown_fields)]
-struct PointLightEntry {
-    #[serde(rename = "type")]
-    _kind: IgnoredAny,
-    position: V3,
-    intensity: Splat3,
-}
-
-fn parse_light(src: &Source, item: Item) -> Result<LightDesc, LoadError> {
-    let span = src.span(item.span().start);
-    let kind = match item_type(src, "light", &item, &["point"])? {
-        "point" => {
-            let l: PointLightEntry = deserialize(src, item)?;
-            LightKindDesc::Point {
-                position: l.position.vec3(),
-                intensity: l.intensity.0,
-            }
-        }
-        _ => unreachable!("item_type checked the type"),
-    };
-    Ok(LightDesc { kind, span })
 }
