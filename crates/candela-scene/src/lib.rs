@@ -34,6 +34,7 @@ use candela_core::desc::{MeshDesc, SceneDesc, Span};
 
 pub mod obj;
 pub mod ply;
+mod toml_camera;
 mod toml_light;
 pub mod toml_scene;
 mod toml_shape;
