@@ -30,7 +30,7 @@ fn asymmetric_table() -> Arc<GoniometricTable> {
     for &phi in &h {
         for &theta in &v {
             let lobe = (-((theta - 20.0) / 25.0).powi(2)).exp();
-            cd.push(1000.0 * lobe * (1.5 + (phi as f64).to_radians().sin()) + 5.0);
+            cd.push(1000.0 * lobe * (1.5 + phi.to_radians().sin()) + 5.0);
         }
     }
     Arc::new(GoniometricTable::new(&v, &h, &cd).unwrap())
