@@ -14,7 +14,7 @@ use crate::desc::{
     MeshDesc, SceneDesc, ShapeDesc, Span, TextureDesc,
 };
 use crate::geometry::Aabb;
-use crate::light::{Light, LightId, LightProfile, SphereLight, TriangleLight};
+use crate::light::{Light, LightId, SphereLight};
 use crate::light_sampler::LightSampler;
 use crate::material::{Material, MaterialId, Texture};
 use crate::scene::{Mesh, Prim, Scene, Sphere};
@@ -90,27 +90,7 @@ pub fn build(desc: &SceneDesc) -> Result<Scene, BuildError> {
     let mut meshes = Vec::new();
     let mut spheres = Vec::new();
     let mut lights = Vec::new();
-    for p in &desc.emission_profiles {
-        let Some(shape) = desc.shapes.get(p.shape) else {
-            return err(
-                &p.span,
-                format!(
-                    "IES profile refers to shape {} of {}",
-                    p.shape,
-                    desc.shapes.len()
-                ),
-            );
-        };
-        if shape.emission.is_none() {
-            return err(
-                &p.span,
-                "an IES profile needs an emitting shape (`emission`)",
-            );
-        }
-        if matches!(shape.geometry, GeometryDesc::Sphere { .. }) {
-            return err(&p.span, "IES profiles are not supported on spheres");
-        }
-    }
+    lights::check_emission_profiles(desc)?;
     for (shape_index, shape) in desc.shapes.iter().enumerate() {
         let Some(&material) = material_ids.get(shape.material.as_str()) else {
             return err(
@@ -154,32 +134,7 @@ pub fn build(desc: &SceneDesc) -> Result<Scene, BuildError> {
                 let mut mesh = to_world(local, shape.transform, material);
                 mesh.flip_normals = shape.flip_normals;
                 if let Some(le) = emission {
-                    let table = desc
-                        .emission_profiles
-                        .iter()
-                        .find(|p| p.shape == shape_index)
-                        .map(|p| p.table.clone());
-                    let c0 = shape.transform.transform_vector3(Vec3::X);
-                    // (normal, profile, projected solid angle) of the last triangle, as
-                    // flat shapes repeat them.
-                    let mut last: Option<(Vec3, LightProfile, f32)> = None;
-                    for tri in 0..mesh.indices.len() as u32 {
-                        let n = mesh.geometric_normal(tri);
-                        mesh.lights.push(LightId(lights.len() as u32));
-                        let mut light = TriangleLight::new(mesh.vertices(tri), n, le);
-                        if let Some(table) = &table {
-                            if last.as_ref().is_none_or(|(ln, _, _)| *ln != n) {
-                                last = LightProfile::new(table.clone(), n, c0).map(|p| {
-                                    let projected = p.projected_solid_angle();
-                                    (n, p, projected)
-                                });
-                            }
-                            if let Some((_, p, projected)) = &last {
-                                light = light.with_profile(p.clone(), *projected);
-                            }
-                        }
-                        lights.push(Light::Triangle(light));
-                    }
+                    lights::triangle_lights(desc, shape_index, &mut mesh, le, &mut lights);
                 }
                 meshes.push(mesh);
             }
@@ -209,19 +164,14 @@ pub fn build(desc: &SceneDesc) -> Result<Scene, BuildError> {
         });
     }
     let bvh = Bvh::build(&boxes);
-    let bounds = boxes.iter().fold(None, |acc: Option<Aabb>, b| {
-        Some(acc.map_or(*b, |a| Aabb {
-            min: a.min.min(b.min),
-            max: a.max.max(b.max),
-        }))
-    });
+    let bounds = boxes.iter().copied().reduce(Aabb::union);
     let scene_radius = bounds.map_or(1.0, |b| (0.5 * (b.max - b.min).length()).max(1e-3));
     for light in &mut lights {
         if let Light::Directional(d) = light {
             d.scene_radius = scene_radius;
         }
     }
-    let light_sampler = LightSampler::new(r.light_sampler, &lights);
+    let light_sampler = LightSampler::new(r.light_sampler, r.ris_candidates, &lights);
     let infinite_lights = lights
         .iter()
         .enumerate()

@@ -238,6 +238,14 @@ fn a_spot_facing_away_contributes_exactly_nothing() {
         n: Vec3::Y,
     };
     assert!(!spot.reaches(ctx.p));
+    // Zero potential contribution, for the light samplers: exact and bounded.
+    assert_eq!(spot.importance(&ctx), 0.0);
+    assert_eq!(spot.bounds().importance(&ctx), 0.0);
+    let lit = ShadingCtx {
+        p: Vec3::new(0.0, 4.0, 0.0),
+        n: -Vec3::Y,
+    };
+    assert!(spot.importance(&lit) > 0.0 && spot.bounds().importance(&lit) > 0.0);
     assert!(Light::Spot(spot)
         .sample_li(&ctx, Vec2::splat(0.5))
         .is_none());

@@ -16,12 +16,17 @@ use std::f32::consts::PI;
 use glam::Vec3;
 
 use super::{check_color, check_finite, err, BuildError};
-use crate::desc::{LightAmountDesc, LightColorDesc, LightDesc, LightKindDesc, ProfileDesc, Span};
+use crate::desc::{
+    GeometryDesc, LightAmountDesc, LightColorDesc, LightDesc, LightKindDesc, ProfileDesc,
+    SceneDesc, Span,
+};
 use crate::light::blackbody::blackbody_rgb;
 use crate::light::{
-    DirectionalLight, GoniometricLight, Light, LightProfile, PointLight, ProjectorLight, SpotLight,
+    DirectionalLight, GoniometricLight, Light, LightId, LightProfile, PointLight, ProjectorLight,
+    SpotLight, TriangleLight,
 };
 use crate::math::luminance;
+use crate::scene::Mesh;
 
 /// Lumens per watt at 555 nm, the definition of the candela.
 pub const LUMENS_PER_WATT: f32 = 683.0;
@@ -269,4 +274,71 @@ pub(super) fn build_light(l: &LightDesc) -> Result<Light, BuildError> {
             Light::Projector(proj)
         }
     })
+}
+
+/// Checks that every IES profile of the description is attached to an emitting shape
+/// that is not a sphere.
+pub(super) fn check_emission_profiles(desc: &SceneDesc) -> Result<(), BuildError> {
+    for p in &desc.emission_profiles {
+        let Some(shape) = desc.shapes.get(p.shape) else {
+            return err(
+                &p.span,
+                format!(
+                    "IES profile refers to shape {} of {}",
+                    p.shape,
+                    desc.shapes.len()
+                ),
+            );
+        };
+        if shape.emission.is_none() {
+            return err(
+                &p.span,
+                "an IES profile needs an emitting shape (`emission`)",
+            );
+        }
+        if matches!(shape.geometry, GeometryDesc::Sphere { .. }) {
+            return err(&p.span, "IES profiles are not supported on spheres");
+        }
+    }
+    Ok(())
+}
+
+/// One light per triangle of the world-space `mesh` of shape `shape_index`, emitting
+/// `le`, shaped by the shape's IES profile if it has one (nadir along each triangle's
+/// normal, C0 along the shape's transformed local +x).
+pub(super) fn triangle_lights(
+    desc: &SceneDesc,
+    shape_index: usize,
+    mesh: &mut Mesh,
+    le: Vec3,
+    lights: &mut Vec<Light>,
+) {
+    let table = desc
+        .emission_profiles
+        .iter()
+        .find(|p| p.shape == shape_index)
+        .map(|p| p.table.clone());
+    let c0 = desc.shapes[shape_index]
+        .transform
+        .transform_vector3(Vec3::X);
+    // (normal, profile, projected solid angle) of the last triangle: flat shapes repeat
+    // them, and the projected solid angle is a quadrature worth reusing.
+    let mut last: Option<(Vec3, LightProfile, f32)> = None;
+    for tri in 0..mesh.indices.len() as u32 {
+        let n = mesh.geometric_normal(tri);
+        mesh.lights.push(LightId(lights.len() as u32));
+        let mut light = TriangleLight::new(mesh.vertices(tri), n, le);
+        if let Some(table) = &table {
+            if last.as_ref().is_none_or(|(ln, _, _)| *ln != n) {
+                last = LightProfile::new(table.clone(), n, c0).map(|p| {
+                    let projected = p.projected_solid_angle();
+                    (n, p, projected)
+                });
+            }
+            if let Some((_, p, projected)) = &last {
+                light = light.with_profile(p.clone(), *projected);
+            }
+        }
+        lights.push(Light::Triangle(light));
+    }
 }

@@ -2,7 +2,7 @@ use std::f32::consts::PI;
 
 use glam::Vec3;
 
-use super::{LightSample, ShadingCtx};
+use super::{receiver_cos, LightSample, ShadingCtx};
 use crate::math::luminance;
 
 /// Parallel light from infinitely far away, travelling along `direction`: a surface facing
@@ -29,6 +29,11 @@ impl DirectionalLight {
             p_light: ctx.p + wi * (2.0 * self.scene_radius),
             n_light: Vec3::ZERO,
         })
+    }
+
+    /// E × the receiver cosine towards the light.
+    pub fn importance(&self, ctx: &ShadingCtx) -> f32 {
+        luminance(self.irradiance) * receiver_cos(ctx, -self.direction)
     }
 
     /// The power crossing the scene's bounding disk, Φ = π r² E (pbrt-v4 §12.4).

@@ -1,6 +1,7 @@
 use glam::{Vec2, Vec3};
 
-use super::{LightProfile, LightSample, ShadingCtx};
+use super::{receiver_cos, LightBounds, LightProfile, LightSample, ShadingCtx};
+use crate::geometry::Aabb;
 use crate::math::luminance;
 
 /// A point light whose intensity follows a goniometric profile (an IES file), after
@@ -36,6 +37,30 @@ impl GoniometricLight {
             p_light: self.position,
             n_light: Vec3::ZERO,
         })
+    }
+
+    /// The exact potential contribution: luminance of I(ω)/d² towards `ctx` times the
+    /// receiver cosine; exactly 0 where the light is dark towards the point.
+    pub fn importance(&self, ctx: &ShadingCtx) -> f32 {
+        let to = ctx.p - self.position;
+        let d2 = to.length_squared();
+        if d2 == 0.0 {
+            return 0.0;
+        }
+        let w = to / d2.sqrt();
+        luminance(self.intensity_towards(w)) / d2 * receiver_cos(ctx, -w)
+    }
+
+    /// Bounded like a point light emitting everywhere at the profile's peak.
+    pub fn bounds(&self) -> LightBounds {
+        LightBounds {
+            aabb: Aabb::from_points(&[self.position]),
+            w: self.profile.frame.n,
+            intensity: luminance(self.intensity),
+            cos_theta_o: -1.0,
+            cos_theta_e: 0.0,
+            two_sided: false,
+        }
     }
 
     /// Φ = I_peak · ∫ I/I_max dω.

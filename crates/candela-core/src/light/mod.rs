@@ -12,6 +12,7 @@
 //! `pdf = 1` and `is_delta`, and are never hit by rays.
 
 pub mod blackbody;
+mod bounds;
 mod directional;
 mod goniometric;
 mod point;
@@ -21,6 +22,7 @@ mod sphere;
 mod spot;
 mod triangle;
 
+pub use bounds::{cone_measure, cone_union, ImportanceBounds, LightBounds};
 pub use directional::DirectionalLight;
 pub use goniometric::GoniometricLight;
 pub use point::PointLight;
@@ -44,6 +46,15 @@ pub struct LightId(pub u32);
 pub struct ShadingCtx {
     pub p: Vec3,
     pub n: Vec3,
+}
+
+/// |n·ω| for a unit direction ω, or 1 where there is no normal.
+pub(crate) fn receiver_cos(ctx: &ShadingCtx, w: Vec3) -> f32 {
+    if ctx.n == Vec3::ZERO {
+        1.0
+    } else {
+        ctx.n.dot(w).abs()
+    }
 }
 
 /// A sampled direction towards a light.
@@ -129,6 +140,37 @@ impl Light {
             Light::Goniometric(l) => l.power(),
             Light::Directional(l) => l.power(),
             Light::Projector(l) => l.power(),
+        }
+    }
+
+    /// Potential contribution at `ctx` up to a common constant, for choosing among lights
+    /// (the RIS target): solid angle × brightness × the largest receiver cosine |n·ω|,
+    /// or intensity ÷ d² for points. It is 0 only where the light provably sends nothing
+    /// that a BSDF could scatter, e.g. a point behind a one-sided emitter; the receiver
+    /// cosine is taken in absolute value so that transmitting BSDFs are not cut off.
+    pub fn importance(&self, ctx: &ShadingCtx) -> f32 {
+        match self {
+            Light::Point(l) => l.importance(ctx),
+            Light::Triangle(l) => l.importance(ctx),
+            Light::Sphere(l) => l.importance(ctx),
+            Light::Spot(l) => l.importance(ctx),
+            Light::Goniometric(l) => l.importance(ctx),
+            Light::Directional(l) => l.importance(ctx),
+            Light::Projector(l) => l.importance(ctx),
+        }
+    }
+
+    /// Bounds for the light BVH; `None` for lights that are not bounded in space (infinite
+    /// lights), which the BVH sampler picks apart from the tree.
+    pub fn bounds(&self) -> Option<LightBounds> {
+        match self {
+            Light::Point(l) => Some(l.bounds()),
+            Light::Triangle(l) => Some(l.bounds()),
+            Light::Sphere(l) => Some(l.bounds()),
+            Light::Spot(l) => Some(l.bounds()),
+            Light::Goniometric(l) => Some(l.bounds()),
+            Light::Projector(l) => Some(l.bounds()),
+            Light::Directional(_) => None,
         }
     }
 

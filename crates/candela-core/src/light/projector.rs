@@ -4,8 +4,9 @@ use std::sync::Arc;
 
 use glam::Vec3;
 
-use super::{LightSample, ShadingCtx};
+use super::{receiver_cos, LightBounds, LightSample, ShadingCtx};
 use crate::desc::ImageDesc;
+use crate::geometry::Aabb;
 use crate::math::luminance;
 
 /// A point light at `position` whose intensity towards ω is `scale` times the linear
@@ -127,6 +128,37 @@ impl ProjectorLight {
             p_light: self.position,
             n_light: Vec3::ZERO,
         })
+    }
+
+    /// The exact potential contribution: luminance of I(ω)/d² towards `ctx` times the
+    /// receiver cosine; exactly 0 where the light is dark towards the point.
+    pub fn importance(&self, ctx: &ShadingCtx) -> f32 {
+        let to = ctx.p - self.position;
+        let d2 = to.length_squared();
+        if d2 == 0.0 {
+            return 0.0;
+        }
+        let w = to / d2.sqrt();
+        luminance(self.intensity_towards(w)) / d2 * receiver_cos(ctx, -w)
+    }
+
+    /// Emission within the cone through the frustum's corners (θ_o), nothing beyond
+    /// (θ_e = 0), at most the brightest pixel.
+    pub fn bounds(&self) -> LightBounds {
+        let peak = self
+            .image
+            .pixels
+            .iter()
+            .map(|&c| luminance(self.scale * c))
+            .fold(0.0f32, f32::max);
+        LightBounds {
+            aabb: Aabb::from_points(&[self.position]),
+            w: self.forward,
+            intensity: peak,
+            cos_theta_o: 1.0 / (1.0 + self.tan_x * self.tan_x + self.tan_y * self.tan_y).sqrt(),
+            cos_theta_e: 1.0,
+            two_sided: false,
+        }
     }
 
     /// Φ = luminance(scale · ∫ image dω), the pixel solid angles taken exactly.

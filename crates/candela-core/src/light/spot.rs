@@ -5,8 +5,9 @@ use std::f32::consts::PI;
 
 use glam::{Vec2, Vec3};
 
-use super::{LightProfile, LightSample, ShadingCtx};
+use super::{receiver_cos, LightBounds, LightProfile, LightSample, ShadingCtx};
 use crate::desc::SpotFalloff;
+use crate::geometry::Aabb;
 use crate::math::{luminance, Frame};
 
 /// A spotlight at `position` aimed along `frame.n`: I(ω) = `intensity` · f(θ) · p(ω),
@@ -122,6 +123,31 @@ impl SpotLight {
     /// ∫ f p dω (sr): the solid angle that turns the axis intensity into a power.
     pub fn solid_angle(&self) -> f32 {
         self.solid_angle
+    }
+
+    /// The exact potential contribution: luminance of I(ω)/d² towards `ctx` times the
+    /// receiver cosine; exactly 0 where the light is dark towards the point.
+    pub fn importance(&self, ctx: &ShadingCtx) -> f32 {
+        let to = ctx.p - self.position;
+        let d2 = to.length_squared();
+        if d2 == 0.0 {
+            return 0.0;
+        }
+        let w = to / d2.sqrt();
+        luminance(self.intensity_towards(w)) / d2 * receiver_cos(ctx, -w)
+    }
+
+    /// pbrt-v4's spotlight bounds (§12.6.3): full intensity within the inner cone
+    /// (θ_o = θ_i) and emission reaching θ_o − θ_i further (θ_e). A profile only darkens.
+    pub fn bounds(&self) -> LightBounds {
+        LightBounds {
+            aabb: Aabb::from_points(&[self.position]),
+            w: self.frame.n,
+            intensity: luminance(self.intensity),
+            cos_theta_o: self.cos_inner,
+            cos_theta_e: (self.outer - self.inner).cos(),
+            two_sided: false,
+        }
     }
 
     /// Φ = I_axis · ∫ f p dω.
