@@ -49,7 +49,7 @@ pub struct ShadingCtx {
 }
 
 /// |n·ω| for a unit direction ω, or 1 where there is no normal.
-pub(crate) fn receiver_cos(ctx: &ShadingCtx, w: Vec3) -> f32 {
+fn receiver_cos(ctx: &ShadingCtx, w: Vec3) -> f32 {
     if ctx.n == Vec3::ZERO {
         1.0
     } else {
