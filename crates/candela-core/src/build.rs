@@ -14,14 +14,18 @@ use crate::bvh::Bvh;
 use crate::camera::Camera;
 use crate::desc::{
     ApertureDesc, ApertureSizeDesc, BsdfDesc, CameraDesc, FocusDesc, GeometryDesc, LensDesc,
-    LightKindDesc, MeshDesc, SceneDesc, ShapeDesc, Span, TextureDesc,
+    MeshDesc, SceneDesc, ShapeDesc, Span, TextureDesc,
 };
 use crate::geometry::Aabb;
-use crate::light::{Light, LightId, PointLight, SphereLight, TriangleLight};
+use crate::light::{Light, LightId, SphereLight};
 use crate::light_sampler::LightSampler;
 use crate::material::{Material, MaterialId, Texture};
 use crate::scene::{Mesh, Prim, Scene, Sphere};
 use crate::texture::ImageTexture;
+
+mod lights;
+
+pub use lights::LUMENS_PER_WATT;
 
 /// A description that cannot be built, with the place that caused it.
 #[derive(Clone, Debug, PartialEq, Eq)]
@@ -90,7 +94,8 @@ pub fn build(desc: &SceneDesc) -> Result<Scene, BuildError> {
     let mut meshes = Vec::new();
     let mut spheres = Vec::new();
     let mut lights = Vec::new();
-    for shape in &desc.shapes {
+    lights::check_emission_profiles(desc)?;
+    for (shape_index, shape) in desc.shapes.iter().enumerate() {
         let Some(&material) = material_ids.get(shape.material.as_str()) else {
             return err(
                 &shape.span,
@@ -133,15 +138,7 @@ pub fn build(desc: &SceneDesc) -> Result<Scene, BuildError> {
                 let mut mesh = to_world(local, shape.transform, material);
                 mesh.flip_normals = shape.flip_normals;
                 if let Some(le) = emission {
-                    for tri in 0..mesh.indices.len() as u32 {
-                        let n = mesh.geometric_normal(tri);
-                        mesh.lights.push(LightId(lights.len() as u32));
-                        lights.push(Light::Triangle(TriangleLight::new(
-                            mesh.vertices(tri),
-                            n,
-                            le,
-                        )));
-                    }
+                    lights::triangle_lights(desc, shape_index, &mut mesh, le, &mut lights);
                 }
                 meshes.push(mesh);
             }
@@ -149,19 +146,7 @@ pub fn build(desc: &SceneDesc) -> Result<Scene, BuildError> {
     }
 
     for l in &desc.lights {
-        match &l.kind {
-            LightKindDesc::Point {
-                position,
-                intensity,
-            } => {
-                check_finite(&l.span, "position", &position.to_array())?;
-                check_color(&l.span, "intensity", *intensity)?;
-                lights.push(Light::Point(PointLight {
-                    position: *position,
-                    intensity: *intensity,
-                }));
-            }
-        }
+        lights.push(lights::build_light(l)?);
     }
 
     let mut prims = Vec::new();
@@ -183,6 +168,13 @@ pub fn build(desc: &SceneDesc) -> Result<Scene, BuildError> {
         });
     }
     let bvh = Bvh::build(&boxes);
+    let bounds = boxes.iter().copied().reduce(Aabb::union);
+    let scene_radius = bounds.map_or(1.0, |b| (0.5 * (b.max - b.min).length()).max(1e-3));
+    for light in &mut lights {
+        if let Light::Directional(d) = light {
+            d.scene_radius = scene_radius;
+        }
+    }
     let light_sampler = LightSampler::new(r.light_sampler, r.ris_candidates, &lights);
     let infinite_lights = lights
         .iter()

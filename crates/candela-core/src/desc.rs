@@ -54,6 +54,8 @@ pub struct SceneDesc {
     pub shapes: Vec<ShapeDesc>,
     pub lights: Vec<LightDesc>,
     pub render: RenderSettings,
+    /// Goniometric profiles attached to emitting shapes (IES-shaped area lights).
+    pub emission_profiles: Vec<EmissionProfileDesc>,
 }
 
 /// A camera placed by position, target and up vector.
@@ -306,6 +308,128 @@ pub struct LightDesc {
 pub enum LightKindDesc {
     /// An isotropic point light of the given radiant intensity (W/sr per channel).
     Point { position: Vec3, intensity: Vec3 },
+    /// A point light with stated units and colour, optionally shaped by a profile.
+    ShapedPoint(ShapedPointDesc),
+    /// A spotlight: a point light whose intensity falls off outside a cone.
+    Spot(SpotLightDesc),
+    /// Parallel light from infinitely far away.
+    Directional(DirectionalLightDesc),
+    /// A point light that projects an image through a rectangular frustum.
+    Projector(ProjectorLightDesc),
+}
+
+// --- Lights with units, profiles and shapes (issue 6) ---------------------------------
+
+/// A light's colour: linear Rec.709, or a blackbody temperature in kelvin.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum LightColorDesc {
+    Rgb(Vec3),
+    Temperature(f32),
+}
+
+impl Default for LightColorDesc {
+    fn default() -> Self {
+        LightColorDesc::Rgb(Vec3::ONE)
+    }
+}
+
+/// How strong a light is, in the unit the user stated. The build converts photometric
+/// units at 683 lm/W and normalizes powers by the light's solid angle (see
+/// [`crate::build`]). Radiometric amounts scale the RGB colour per channel; photometric
+/// amounts scale the colour normalized to unit luminance.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum LightAmountDesc {
+    /// Peak radiant intensity, W/sr (the intensity along the axis / profile peak).
+    WattsPerSr(f32),
+    /// Peak luminous intensity, cd.
+    Candela(f32),
+    /// Total emitted power, W.
+    Watts(f32),
+    /// Total luminous flux, lm.
+    Lumens(f32),
+    /// The absolute candela values of the attached profile (IES files are absolute).
+    ProfileCandela,
+}
+
+/// A goniometric profile placed in the world: the table's nadir (+z of the table frame)
+/// along `nadir`, its C0 plane towards `c0` (made orthogonal to `nadir`).
+#[derive(Clone, Debug)]
+pub struct ProfileDesc {
+    pub table: Arc<crate::photometry::GoniometricTable>,
+    pub nadir: Vec3,
+    pub c0: Vec3,
+    pub span: Span,
+}
+
+/// See [`LightKindDesc::ShapedPoint`].
+#[derive(Clone, Debug)]
+pub struct ShapedPointDesc {
+    pub position: Vec3,
+    pub color: LightColorDesc,
+    pub amount: LightAmountDesc,
+    pub profile: Option<ProfileDesc>,
+}
+
+/// The angular falloff of a spotlight between its inner and outer cone.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum SpotFalloff {
+    /// pbrt-v4: smoothstep in cos θ.
+    #[default]
+    Smoothstep,
+    /// Mitsuba 3: linear in the angle θ.
+    Mitsuba,
+    /// glTF KHR_lights_punctual: the square of a linear ramp in cos θ.
+    Gltf,
+}
+
+/// See [`LightKindDesc::Spot`]. A profile, if any, is aimed along `direction` and
+/// multiplies the cone's falloff.
+#[derive(Clone, Debug)]
+pub struct SpotLightDesc {
+    pub position: Vec3,
+    pub direction: Vec3,
+    pub inner_angle_deg: f32,
+    pub outer_angle_deg: f32,
+    pub falloff: SpotFalloff,
+    pub color: LightColorDesc,
+    pub amount: LightAmountDesc,
+    pub profile: Option<ProfileDesc>,
+}
+
+/// See [`LightKindDesc::Directional`]. `direction` is the way the light travels.
+/// Amounts: `WattsPerSr`/`Candela` are read as irradiance (W/m²) / illuminance (lux) on a
+/// surface facing the light; `Watts`/`Lumens` are not accepted.
+#[derive(Clone, Debug)]
+pub struct DirectionalLightDesc {
+    pub direction: Vec3,
+    pub color: LightColorDesc,
+    pub amount: LightAmountDesc,
+}
+
+/// See [`LightKindDesc::Projector`]. The image spans the frustum `fov_x_deg` ×
+/// `fov_y_deg` around `direction`, its top edge towards `up`. The intensity towards a
+/// direction is the pixel's linear value times the scale the amount gives (the amount
+/// refers to a pixel value of 1).
+#[derive(Clone, Debug)]
+pub struct ProjectorLightDesc {
+    pub position: Vec3,
+    pub direction: Vec3,
+    pub up: Vec3,
+    pub fov_x_deg: f32,
+    pub fov_y_deg: f32,
+    pub image: Arc<ImageDesc>,
+    pub color: LightColorDesc,
+    pub amount: LightAmountDesc,
+}
+
+/// A profile attached to the emitting shape `shape` (index into [`SceneDesc::shapes`]):
+/// its radiance towards ω is scaled by I(ω)/I_max, the table's nadir along the surface
+/// normal and its C0 plane along the shape's transformed local +x.
+#[derive(Clone, Debug)]
+pub struct EmissionProfileDesc {
+    pub shape: usize,
+    pub table: Arc<crate::photometry::GoniometricTable>,
+    pub span: Span,
 }
 
 /// How to weigh next event estimation against BSDF sampling.

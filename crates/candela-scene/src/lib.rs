@@ -36,6 +36,7 @@ pub mod image_texture;
 pub mod obj;
 pub mod ply;
 mod toml_camera;
+mod toml_light;
 mod toml_material;
 pub mod toml_scene;
 mod toml_shape;

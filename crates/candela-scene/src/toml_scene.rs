@@ -10,17 +10,17 @@
 use std::path::Path;
 
 use candela_core::desc::{
-    LightDesc, LightKindDesc, LightSamplerKind, MaterialDesc, MisMode, RenderSettings, SceneDesc,
+    EmissionProfileDesc, LightSamplerKind, MaterialDesc, MisMode, RenderSettings, SceneDesc,
 };
-use serde::de::{DeserializeOwned, IgnoredAny};
+use serde::de::DeserializeOwned;
 use serde::Deserialize;
 use toml::de::{DeTable, DeValue, ValueDeserializer};
 use toml::Spanned;
 
 use crate::toml_camera::parse_camera;
+use crate::toml_light::parse_light;
 use crate::toml_material::{parse_material, MATERIAL_TYPES};
 use crate::toml_shape::parse_shape;
-use crate::toml_values::{Splat3, V3};
 use crate::{LoadError, Source};
 
 /// One item of the parsed tree: a value and its byte range in the text.
@@ -41,12 +41,20 @@ pub fn parse_toml_scene(text: &str, file: &Path) -> Result<SceneDesc, LoadError>
             "materials" => desc.materials = parse_materials(&src, base, value)?,
             "shape" => {
                 for item in array_of_tables(&src, "shape", value)? {
-                    desc.shapes.push(parse_shape(&src, base, item)?);
+                    let (shape, profile) = parse_shape(&src, base, item)?;
+                    if let Some((table, span)) = profile {
+                        desc.emission_profiles.push(EmissionProfileDesc {
+                            shape: desc.shapes.len(),
+                            table,
+                            span,
+                        });
+                    }
+                    desc.shapes.push(shape);
                 }
             }
             "light" => {
                 for item in array_of_tables(&src, "light", value)? {
-                    desc.lights.push(parse_light(&src, item)?);
+                    desc.lights.push(parse_light(&src, base, item)?);
                 }
             }
             other => {
@@ -213,28 +221,4 @@ fn parse_materials(src: &Source, base: &Path, value: Item) -> Result<Vec<Materia
         });
     }
     Ok(out)
-}
-
-#[derive(Deserialize)]
-#[serde(deny_unknown_fields)]
-struct PointLightEntry {
-    #[serde(rename = "type")]
-    _kind: IgnoredAny,
-    position: V3,
-    intensity: Splat3,
-}
-
-fn parse_light(src: &Source, item: Item) -> Result<LightDesc, LoadError> {
-    let span = src.span(item.span().start);
-    let kind = match item_type(src, "light", &item, &["point"])? {
-        "point" => {
-            let l: PointLightEntry = deserialize(src, item)?;
-            LightKindDesc::Point {
-                position: l.position.vec3(),
-                intensity: l.intensity.0,
-            }
-        }
-        _ => unreachable!("item_type checked the type"),
-    };
-    Ok(LightDesc { kind, span })
 }

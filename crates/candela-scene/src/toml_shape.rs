@@ -2,7 +2,10 @@
 
 use std::path::Path;
 
-use candela_core::desc::{GeometryDesc, MeshDesc, ShapeDesc};
+use std::sync::Arc;
+
+use candela_core::desc::{GeometryDesc, MeshDesc, ShapeDesc, Span};
+use candela_core::photometry::GoniometricTable;
 use glam::{Mat4, Vec3, Vec4};
 use serde::de::IgnoredAny;
 use serde::Deserialize;
@@ -92,6 +95,7 @@ fn compose(src: &Source, ops: Vec<Spanned<TransformOp>>) -> Result<Mat4, LoadErr
 struct Common {
     material: String,
     emission: Option<Splat3>,
+    ies: Option<Spanned<String>>,
     flip_normals: Option<bool>,
     transform: Option<Vec<Spanned<TransformOp>>>,
 }
@@ -108,6 +112,7 @@ struct MeshEntry {
     uvs: Option<Spanned<Vec<V2>>>,
     material: String,
     emission: Option<Splat3>,
+    ies: Option<Spanned<String>>,
     flip_normals: Option<bool>,
     transform: Option<Vec<Spanned<TransformOp>>>,
 }
@@ -121,6 +126,7 @@ struct SphereEntry {
     radius: Option<Num>,
     material: String,
     emission: Option<Splat3>,
+    ies: Option<Spanned<String>>,
     flip_normals: Option<bool>,
     transform: Option<Vec<Spanned<TransformOp>>>,
 }
@@ -133,14 +139,23 @@ struct PrimitiveEntry {
     _kind: IgnoredAny,
     material: String,
     emission: Option<Splat3>,
+    ies: Option<Spanned<String>>,
     flip_normals: Option<bool>,
     transform: Option<Vec<Spanned<TransformOp>>>,
 }
 
 const SHAPE_TYPES: &[&str] = &["mesh", "sphere", "rectangle", "disk", "cube"];
 
-/// Parses one `[[shape]]` entry; mesh files resolve against `base`.
-pub(crate) fn parse_shape(src: &Source, base: &Path, item: Item) -> Result<ShapeDesc, LoadError> {
+/// An IES profile attached to an emitting shape, and where it was named.
+pub(crate) type ShapeProfile = (Arc<GoniometricTable>, Span);
+
+/// Parses one `[[shape]]` entry and its IES profile, if any; files resolve against
+/// `base`.
+pub(crate) fn parse_shape(
+    src: &Source,
+    base: &Path,
+    item: Item,
+) -> Result<(ShapeDesc, Option<ShapeProfile>), LoadError> {
     let at = item.span().start;
     let kind = item_type(src, "shape", &item, SHAPE_TYPES)?;
     check_transform_steps(src, &item)?;
@@ -150,6 +165,7 @@ pub(crate) fn parse_shape(src: &Source, base: &Path, item: Item) -> Result<Shape
             let common = Common {
                 material: e.material,
                 emission: e.emission,
+                ies: e.ies,
                 flip_normals: e.flip_normals,
                 transform: e.transform,
             };
@@ -185,6 +201,7 @@ pub(crate) fn parse_shape(src: &Source, base: &Path, item: Item) -> Result<Shape
             let common = Common {
                 material: e.material,
                 emission: e.emission,
+                ies: e.ies,
                 flip_normals: e.flip_normals,
                 transform: e.transform,
             };
@@ -200,20 +217,38 @@ pub(crate) fn parse_shape(src: &Source, base: &Path, item: Item) -> Result<Shape
             let common = Common {
                 material: e.material,
                 emission: e.emission,
+                ies: e.ies,
                 flip_normals: e.flip_normals,
                 transform: e.transform,
             };
             (geometry, common)
         }
     };
-    Ok(ShapeDesc {
+    let profile = match &common.ies {
+        None => None,
+        Some(file) if common.emission.is_none() => {
+            return Err(src.error(
+                file.span().start,
+                "`ies` shapes an emitter's radiance; the shape needs an `emission`",
+            ))
+        }
+        Some(file) if matches!(geometry, GeometryDesc::Sphere { .. }) => {
+            return Err(src.error(file.span().start, "`ies` is not supported on spheres"))
+        }
+        Some(file) => Some((
+            crate::toml_light::load_ies_table(src, base, file)?,
+            src.span(file.span().start),
+        )),
+    };
+    let shape = ShapeDesc {
         geometry,
         material: common.material,
         emission: common.emission.map(|c| c.0),
         transform: compose(src, common.transform.unwrap_or_default())?,
         flip_normals: common.flip_normals.unwrap_or(false),
         span: src.span(at),
-    })
+    };
+    Ok((shape, profile))
 }
 
 /// Gives a step with several keys a clearer error than serde's enum message.

@@ -275,12 +275,13 @@ fn transform_errors() {
 #[test]
 fn light_errors() {
     assert_eq!(
-        error("[[light]]\ntype = \"spot\"\n"),
-        "scene.toml:2:8: unknown light type `spot`, expected one of `point`"
+        error("[[light]]\ntype = \"area\"\n"),
+        "scene.toml:2:8: unknown light type `area`, expected one of `point`, `spot`, \
+         `directional`, `projector`"
     );
     assert_eq!(
         error("[[light]]\ntype = \"point\"\nposition = [0, 1, 0]\n"),
-        "scene.toml:1:1: missing field `intensity`"
+        "scene.toml:1:1: the light needs an intensity or a `power`"
     );
 }
 

@@ -127,7 +127,10 @@ fn materials_lights_and_primitives() {
     let LightKindDesc::Point {
         position,
         intensity,
-    } = l.kind;
+    } = l.kind
+    else {
+        panic!("expected a point light, got {:?}", l.kind);
+    };
     assert_eq!((position, intensity), (Vec3::Y * 5.0, Vec3::splat(7.0)));
     assert_eq!(l.span, Span::new("scene.toml", 29, 1));
     candela_core::build::build(&desc).unwrap();

@@ -7,17 +7,29 @@
 //! - **radiance** ([`Light::radiance`] when a ray hits an area light, [`Light::le`] when
 //!   a ray escapes to an infinite light).
 //!
-//! All densities are in solid angle at the shading point. Delta lights (points) report
+//! All densities are in solid angle at the shading point. Delta lights (points, spots,
+//! goniometric, directional and projector lights) report
 //! `pdf = 1` and `is_delta`, and are never hit by rays.
 
+pub mod blackbody;
 mod bounds;
+mod directional;
+mod goniometric;
 mod point;
+mod profile;
+mod projector;
 mod sphere;
+mod spot;
 mod triangle;
 
 pub use bounds::{cone_measure, cone_union, ImportanceBounds, LightBounds};
+pub use directional::DirectionalLight;
+pub use goniometric::GoniometricLight;
 pub use point::PointLight;
+pub use profile::LightProfile;
+pub use projector::ProjectorLight;
 pub use sphere::SphereLight;
+pub use spot::SpotLight;
 pub use triangle::TriangleLight;
 
 use glam::{Vec2, Vec3};
@@ -67,6 +79,10 @@ pub enum Light {
     Point(PointLight),
     Triangle(TriangleLight),
     Sphere(SphereLight),
+    Spot(SpotLight),
+    Goniometric(GoniometricLight),
+    Directional(DirectionalLight),
+    Projector(ProjectorLight),
 }
 
 impl Light {
@@ -75,6 +91,10 @@ impl Light {
             Light::Point(l) => l.sample_li(ctx),
             Light::Triangle(l) => l.sample_li(ctx, u),
             Light::Sphere(l) => l.sample_li(ctx, u),
+            Light::Spot(l) => l.sample_li(ctx),
+            Light::Goniometric(l) => l.sample_li(ctx),
+            Light::Directional(l) => l.sample_li(ctx),
+            Light::Projector(l) => l.sample_li(ctx),
         }?;
         (s.pdf > 0.0 && s.pdf.is_finite() && s.radiance != Vec3::ZERO).then_some(s)
     }
@@ -82,7 +102,11 @@ impl Light {
     /// Density in solid angle with which [`Self::sample_li`] picks direction `wi` at `ctx`.
     pub fn pdf_li(&self, ctx: &ShadingCtx, wi: Vec3) -> f32 {
         match self {
-            Light::Point(_) => 0.0,
+            Light::Point(_)
+            | Light::Spot(_)
+            | Light::Goniometric(_)
+            | Light::Directional(_)
+            | Light::Projector(_) => 0.0,
             Light::Triangle(l) => l.pdf_li(ctx, wi),
             Light::Sphere(l) => l.pdf_li(ctx, wi),
         }
@@ -91,7 +115,11 @@ impl Light {
     /// Radiance leaving an area light at a point with geometric normal `n` in direction `w`.
     pub fn radiance(&self, n: Vec3, w: Vec3) -> Vec3 {
         match self {
-            Light::Point(_) => Vec3::ZERO,
+            Light::Point(_)
+            | Light::Spot(_)
+            | Light::Goniometric(_)
+            | Light::Directional(_)
+            | Light::Projector(_) => Vec3::ZERO,
             Light::Triangle(l) => l.radiance(n, w),
             Light::Sphere(l) => l.radiance(n, w),
         }
@@ -99,9 +127,7 @@ impl Light {
 
     /// Radiance an infinite light sends along an escaped ray.
     pub fn le(&self, _ray: &Ray) -> Vec3 {
-        match self {
-            Light::Point(_) | Light::Triangle(_) | Light::Sphere(_) => Vec3::ZERO,
-        }
+        Vec3::ZERO
     }
 
     /// Total emitted power Φ, as a luminance-weighted scalar (W).
@@ -110,6 +136,10 @@ impl Light {
             Light::Point(l) => l.power(),
             Light::Triangle(l) => l.power(),
             Light::Sphere(l) => l.power(),
+            Light::Spot(l) => l.power(),
+            Light::Goniometric(l) => l.power(),
+            Light::Directional(l) => l.power(),
+            Light::Projector(l) => l.power(),
         }
     }
 
@@ -123,6 +153,10 @@ impl Light {
             Light::Point(l) => l.importance(ctx),
             Light::Triangle(l) => l.importance(ctx),
             Light::Sphere(l) => l.importance(ctx),
+            Light::Spot(l) => l.importance(ctx),
+            Light::Goniometric(l) => l.importance(ctx),
+            Light::Directional(l) => l.importance(ctx),
+            Light::Projector(l) => l.importance(ctx),
         }
     }
 
@@ -133,11 +167,22 @@ impl Light {
             Light::Point(l) => Some(l.bounds()),
             Light::Triangle(l) => Some(l.bounds()),
             Light::Sphere(l) => Some(l.bounds()),
+            Light::Spot(l) => Some(l.bounds()),
+            Light::Goniometric(l) => Some(l.bounds()),
+            Light::Projector(l) => Some(l.bounds()),
+            Light::Directional(_) => None,
         }
     }
 
     pub fn is_delta(&self) -> bool {
-        matches!(self, Light::Point(_))
+        matches!(
+            self,
+            Light::Point(_)
+                | Light::Spot(_)
+                | Light::Goniometric(_)
+                | Light::Directional(_)
+                | Light::Projector(_)
+        )
     }
 
     /// Whether escaped rays see this light (environment lights).

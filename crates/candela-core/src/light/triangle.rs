@@ -2,7 +2,7 @@ use std::f32::consts::PI;
 
 use glam::{Vec2, Vec3};
 
-use super::{receiver_cos, LightBounds, LightSample, ShadingCtx};
+use super::{receiver_cos, LightBounds, LightProfile, LightSample, ShadingCtx};
 use crate::geometry::Aabb;
 use crate::geometry::{Ray, WatertightRay};
 use crate::math::luminance;
@@ -11,19 +11,53 @@ use crate::sampling::sample_uniform_triangle;
 /// One emitting triangle of a mesh. Emits `le` on the side its normal `n` points to.
 /// Sampled uniformly by area; the density is converted to solid angle at the shading
 /// point, p_ω = d² / (|cos θ_l| · A).
+///
+/// With a `profile` (an IES-shaped area light) the radiance leaving towards ω is
+/// `le` · I(ω)/I_max, the profile's nadir along `n`: each point of the surface emits with
+/// the profile's shape times the Lambertian cos θ, so the triangle's intensity is
+/// A · `le` · cos θ · I(ω)/I_max. Sampling stays uniform by area (its density does not
+/// depend on the emitted radiance; only the value does).
 #[derive(Clone, Debug)]
 pub struct TriangleLight {
     pub p: [Vec3; 3],
     pub n: Vec3,
     pub area: f32,
     pub le: Vec3,
+    pub profile: Option<LightProfile>,
+    /// ∫ (radiance / `le`) cos θ dω over the hemisphere: π without a profile.
+    pub projected_solid_angle: f32,
 }
 
 impl TriangleLight {
     /// A light for a triangle with unit normal `n` (the emitting side).
     pub fn new(p: [Vec3; 3], n: Vec3, le: Vec3) -> TriangleLight {
         let area = 0.5 * (p[1] - p[0]).cross(p[2] - p[0]).length();
-        TriangleLight { p, n, area, le }
+        TriangleLight {
+            p,
+            n,
+            area,
+            le,
+            profile: None,
+            projected_solid_angle: PI,
+        }
+    }
+
+    /// The same triangle shaped by `profile` (its nadir should be `n`), whose
+    /// [`LightProfile::projected_solid_angle`] is `projected`.
+    pub fn with_profile(self, profile: LightProfile, projected: f32) -> TriangleLight {
+        TriangleLight {
+            profile: Some(profile),
+            projected_solid_angle: projected,
+            ..self
+        }
+    }
+
+    /// Radiance leaving towards the unit direction `w` on the emitting side.
+    fn emitted(&self, w: Vec3) -> Vec3 {
+        match &self.profile {
+            None => self.le,
+            Some(p) => self.le * p.relative(w),
+        }
     }
 
     pub fn sample_li(&self, ctx: &ShadingCtx, u: Vec2) -> Option<LightSample> {
@@ -41,7 +75,7 @@ impl TriangleLight {
             return None;
         }
         Some(LightSample {
-            radiance: self.le,
+            radiance: self.emitted(-wi),
             wi,
             distance,
             pdf: d2 / (cos_l * self.area),
@@ -65,15 +99,15 @@ impl TriangleLight {
 
     pub fn radiance(&self, n: Vec3, w: Vec3) -> Vec3 {
         if n.dot(w) > 0.0 {
-            self.le
+            self.emitted(w)
         } else {
             Vec3::ZERO
         }
     }
 
-    /// Φ = π · A · L for a one-sided Lambertian emitter.
+    /// Φ = A · L · ∫ shape · cos θ dω: π · A · L for a one-sided Lambertian emitter.
     pub fn power(&self) -> f32 {
-        PI * self.area * luminance(self.le)
+        self.projected_solid_angle * self.area * luminance(self.le)
     }
 
     /// L × Ω × the largest |cos| at the receiver over the three corners, where Ω is the

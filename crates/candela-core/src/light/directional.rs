@@ -1,0 +1,43 @@
+use std::f32::consts::PI;
+
+use glam::Vec3;
+
+use super::{receiver_cos, LightSample, ShadingCtx};
+use crate::math::luminance;
+
+/// Parallel light from infinitely far away, travelling along `direction`: a surface facing
+/// it receives irradiance `irradiance` (W/m²). A delta light in direction; shadow rays go
+/// to infinity.
+#[derive(Clone, Debug)]
+pub struct DirectionalLight {
+    /// Unit direction the light travels in.
+    pub direction: Vec3,
+    pub irradiance: Vec3,
+    /// Radius of a sphere bounding the scene, for the power estimate.
+    pub scene_radius: f32,
+}
+
+impl DirectionalLight {
+    pub fn sample_li(&self, ctx: &ShadingCtx) -> Option<LightSample> {
+        let wi = -self.direction;
+        Some(LightSample {
+            radiance: self.irradiance,
+            wi,
+            distance: f32::INFINITY,
+            pdf: 1.0,
+            is_delta: true,
+            p_light: ctx.p + wi * (2.0 * self.scene_radius),
+            n_light: Vec3::ZERO,
+        })
+    }
+
+    /// E × the receiver cosine towards the light.
+    pub fn importance(&self, ctx: &ShadingCtx) -> f32 {
+        luminance(self.irradiance) * receiver_cos(ctx, -self.direction)
+    }
+
+    /// The power crossing the scene's bounding disk, Φ = π r² E (pbrt-v4 §12.4).
+    pub fn power(&self) -> f32 {
+        PI * self.scene_radius * self.scene_radius * luminance(self.irradiance)
+    }
+}

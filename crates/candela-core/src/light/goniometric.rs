@@ -1,0 +1,81 @@
+use glam::{Vec2, Vec3};
+
+use super::{receiver_cos, LightBounds, LightProfile, LightSample, ShadingCtx};
+use crate::geometry::Aabb;
+use crate::math::luminance;
+
+/// A point light whose intensity follows a goniometric profile (an IES file), after
+/// pbrt-v4's `GoniometricLight`: I(ω) = `intensity` · I_table(ω)/I_max, so `intensity`
+/// is the intensity at the profile's peak.
+#[derive(Clone, Debug)]
+pub struct GoniometricLight {
+    pub position: Vec3,
+    pub intensity: Vec3,
+    pub profile: LightProfile,
+}
+
+impl GoniometricLight {
+    /// Radiant intensity (W/sr) towards the unit direction `w` leaving the light.
+    pub fn intensity_towards(&self, w: Vec3) -> Vec3 {
+        self.intensity * self.profile.relative(w)
+    }
+
+    pub fn sample_li(&self, ctx: &ShadingCtx) -> Option<LightSample> {
+        let to = self.position - ctx.p;
+        let d2 = to.length_squared();
+        if d2 == 0.0 {
+            return None;
+        }
+        let distance = d2.sqrt();
+        let wi = to / distance;
+        Some(LightSample {
+            radiance: self.intensity_towards(-wi) / d2,
+            wi,
+            distance,
+            pdf: 1.0,
+            is_delta: true,
+            p_light: self.position,
+            n_light: Vec3::ZERO,
+        })
+    }
+
+    /// The exact potential contribution: luminance of I(ω)/d² towards `ctx` times the
+    /// receiver cosine; exactly 0 where the light is dark towards the point.
+    pub fn importance(&self, ctx: &ShadingCtx) -> f32 {
+        let to = ctx.p - self.position;
+        let d2 = to.length_squared();
+        if d2 == 0.0 {
+            return 0.0;
+        }
+        let w = to / d2.sqrt();
+        luminance(self.intensity_towards(w)) / d2 * receiver_cos(ctx, -w)
+    }
+
+    /// Bounded like a point light emitting everywhere at the profile's peak.
+    pub fn bounds(&self) -> LightBounds {
+        LightBounds {
+            aabb: Aabb::from_points(&[self.position]),
+            w: self.profile.frame.n,
+            intensity: luminance(self.intensity),
+            cos_theta_o: -1.0,
+            cos_theta_e: 0.0,
+            two_sided: false,
+        }
+    }
+
+    /// Φ = I_peak · ∫ I/I_max dω.
+    pub fn power(&self) -> f32 {
+        luminance(self.intensity) * self.profile.solid_angle()
+    }
+
+    /// An emission direction drawn from the profile table, with its solid-angle density.
+    pub fn sample_emission(&self, u: Vec2) -> Option<(Vec3, f32)> {
+        let (w, pdf) = self.profile.sample(u);
+        (pdf > 0.0).then_some((w, pdf))
+    }
+
+    /// Density of [`Self::sample_emission`].
+    pub fn emission_pdf(&self, w: Vec3) -> f32 {
+        self.profile.pdf(w)
+    }
+}

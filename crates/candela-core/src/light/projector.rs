@@ -1,0 +1,168 @@
+//! A projector: a point light that casts an image through a rectangular frustum.
+
+use std::sync::Arc;
+
+use glam::Vec3;
+
+use super::{receiver_cos, LightBounds, LightSample, ShadingCtx};
+use crate::desc::ImageDesc;
+use crate::geometry::Aabb;
+use crate::math::luminance;
+
+/// A point light at `position` whose intensity towards ω is `scale` times the linear
+/// value of the image pixel ω passes through, the image spanning the frustum
+/// `tan_x` × `tan_y` (tangents of the half fields of view) around `forward`, its top edge
+/// towards `up` and its right edge towards `right`. Pixels are looked up nearest (a
+/// projector shows its pixels as squares); outside the frustum the intensity is 0.
+#[derive(Clone, Debug)]
+pub struct ProjectorLight {
+    pub position: Vec3,
+    pub forward: Vec3,
+    pub right: Vec3,
+    pub up: Vec3,
+    pub tan_x: f32,
+    pub tan_y: f32,
+    pub image: Arc<ImageDesc>,
+    pub scale: Vec3,
+    /// ∫ image(ω) dω per channel (sr).
+    image_integral: Vec3,
+}
+
+/// Solid angle of the rectangle [0, x] × [0, y] of the plane at distance 1 seen from the
+/// origin: atan(xy / √(1 + x² + y²)) (a signed corner term; differences give any
+/// rectangle).
+fn corner(x: f64, y: f64) -> f64 {
+    (x * y / (1.0 + x * x + y * y).sqrt()).atan()
+}
+
+impl ProjectorLight {
+    /// A projector aimed along `direction`; `up` need only not be parallel to it.
+    pub fn new(
+        position: Vec3,
+        direction: Vec3,
+        up: Vec3,
+        fov_x_rad: f32,
+        fov_y_rad: f32,
+        image: Arc<ImageDesc>,
+        scale: Vec3,
+    ) -> ProjectorLight {
+        let forward = direction.normalize();
+        let right = forward.cross(up).normalize();
+        let mut p = ProjectorLight {
+            position,
+            forward,
+            right,
+            up: right.cross(forward),
+            tan_x: (0.5 * fov_x_rad).tan(),
+            tan_y: (0.5 * fov_y_rad).tan(),
+            image,
+            scale,
+            image_integral: Vec3::ZERO,
+        };
+        let sum = p
+            .pixel_solid_angles()
+            .fold(glam::DVec3::ZERO, |acc, (i, o)| {
+                acc + p.image.pixels[i].as_dvec3() * o
+            });
+        p.image_integral = sum.as_vec3();
+        p
+    }
+
+    /// (pixel index, solid angle of the pixel) for every pixel, exactly.
+    fn pixel_solid_angles(&self) -> impl Iterator<Item = (usize, f64)> + '_ {
+        let (w, h) = (self.image.width as usize, self.image.height as usize);
+        let (tx, ty) = (self.tan_x as f64, self.tan_y as f64);
+        (0..w * h).map(move |i| {
+            let (col, row) = (i % w, i / w);
+            let x0 = tx * (2.0 * col as f64 / w as f64 - 1.0);
+            let x1 = tx * (2.0 * (col + 1) as f64 / w as f64 - 1.0);
+            let y1 = ty * (1.0 - 2.0 * row as f64 / h as f64);
+            let y0 = ty * (1.0 - 2.0 * (row + 1) as f64 / h as f64);
+            let omega = corner(x1, y1) - corner(x0, y1) - corner(x1, y0) + corner(x0, y0);
+            (i, omega)
+        })
+    }
+
+    /// ∫ image(ω) dω per channel: what turns `scale` into a power per channel.
+    pub fn image_integral(&self) -> Vec3 {
+        self.image_integral
+    }
+
+    /// The pixel that the unit direction `w` leaving the light passes through.
+    pub fn pixel_towards(&self, w: Vec3) -> Option<usize> {
+        let z = w.dot(self.forward);
+        if z <= 0.0 {
+            return None;
+        }
+        let x = w.dot(self.right) / (z * self.tan_x);
+        let y = w.dot(self.up) / (z * self.tan_y);
+        if !(-1.0..=1.0).contains(&x) || !(-1.0..=1.0).contains(&y) {
+            return None;
+        }
+        let (wd, ht) = (self.image.width, self.image.height);
+        let col = (((x + 1.0) * 0.5 * wd as f32) as u32).min(wd - 1);
+        let row = (((1.0 - y) * 0.5 * ht as f32) as u32).min(ht - 1);
+        Some((row * wd + col) as usize)
+    }
+
+    /// Radiant intensity (W/sr) towards the unit direction `w` leaving the light.
+    pub fn intensity_towards(&self, w: Vec3) -> Vec3 {
+        self.pixel_towards(w)
+            .map_or(Vec3::ZERO, |i| self.scale * self.image.pixels[i])
+    }
+
+    pub fn sample_li(&self, ctx: &ShadingCtx) -> Option<LightSample> {
+        let to = self.position - ctx.p;
+        let d2 = to.length_squared();
+        if d2 == 0.0 {
+            return None;
+        }
+        let distance = d2.sqrt();
+        let wi = to / distance;
+        Some(LightSample {
+            radiance: self.intensity_towards(-wi) / d2,
+            wi,
+            distance,
+            pdf: 1.0,
+            is_delta: true,
+            p_light: self.position,
+            n_light: Vec3::ZERO,
+        })
+    }
+
+    /// The exact potential contribution: luminance of I(ω)/d² towards `ctx` times the
+    /// receiver cosine; exactly 0 where the light is dark towards the point.
+    pub fn importance(&self, ctx: &ShadingCtx) -> f32 {
+        let to = ctx.p - self.position;
+        let d2 = to.length_squared();
+        if d2 == 0.0 {
+            return 0.0;
+        }
+        let w = to / d2.sqrt();
+        luminance(self.intensity_towards(w)) / d2 * receiver_cos(ctx, -w)
+    }
+
+    /// Emission within the cone through the frustum's corners (θ_o), nothing beyond
+    /// (θ_e = 0), at most the brightest pixel.
+    pub fn bounds(&self) -> LightBounds {
+        let peak = self
+            .image
+            .pixels
+            .iter()
+            .map(|&c| luminance(self.scale * c))
+            .fold(0.0f32, f32::max);
+        LightBounds {
+            aabb: Aabb::from_points(&[self.position]),
+            w: self.forward,
+            intensity: peak,
+            cos_theta_o: 1.0 / (1.0 + self.tan_x * self.tan_x + self.tan_y * self.tan_y).sqrt(),
+            cos_theta_e: 1.0,
+            two_sided: false,
+        }
+    }
+
+    /// Φ = luminance(scale · ∫ image dω), the pixel solid angles taken exactly.
+    pub fn power(&self) -> f32 {
+        luminance(self.scale * self.image_integral)
+    }
+}
