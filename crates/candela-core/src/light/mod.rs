@@ -10,10 +10,13 @@
 //! All densities are in solid angle at the shading point. Delta lights (points) report
 //! `pdf = 1` and `is_delta`, and are never hit by rays.
 
+mod environment;
+pub mod envmap;
 mod point;
 mod sphere;
 mod triangle;
 
+pub use environment::{EnvironmentLight, EnvironmentMap, EnvironmentSampling};
 pub use point::PointLight;
 pub use sphere::SphereLight;
 pub use triangle::TriangleLight;
@@ -56,6 +59,7 @@ pub enum Light {
     Point(PointLight),
     Triangle(TriangleLight),
     Sphere(SphereLight),
+    Environment(EnvironmentLight),
 }
 
 impl Light {
@@ -64,6 +68,7 @@ impl Light {
             Light::Point(l) => l.sample_li(ctx),
             Light::Triangle(l) => l.sample_li(ctx, u),
             Light::Sphere(l) => l.sample_li(ctx, u),
+            Light::Environment(l) => l.sample_li(ctx, u),
         }?;
         (s.pdf > 0.0 && s.pdf.is_finite() && s.radiance != Vec3::ZERO).then_some(s)
     }
@@ -74,22 +79,33 @@ impl Light {
             Light::Point(_) => 0.0,
             Light::Triangle(l) => l.pdf_li(ctx, wi),
             Light::Sphere(l) => l.pdf_li(ctx, wi),
+            Light::Environment(l) => l.pdf_li(ctx, wi),
         }
     }
 
     /// Radiance leaving an area light at a point with geometric normal `n` in direction `w`.
     pub fn radiance(&self, n: Vec3, w: Vec3) -> Vec3 {
         match self {
-            Light::Point(_) => Vec3::ZERO,
+            Light::Point(_) | Light::Environment(_) => Vec3::ZERO,
             Light::Triangle(l) => l.radiance(n, w),
             Light::Sphere(l) => l.radiance(n, w),
         }
     }
 
     /// Radiance an infinite light sends along an escaped ray.
-    pub fn le(&self, _ray: &Ray) -> Vec3 {
+    pub fn le(&self, ray: &Ray) -> Vec3 {
         match self {
+            Light::Environment(l) => l.le(ray),
             Light::Point(_) | Light::Triangle(_) | Light::Sphere(_) => Vec3::ZERO,
+        }
+    }
+
+    /// What an escaped camera ray sees of an infinite light: [`Self::le`], unless the
+    /// light is hidden from the camera.
+    pub fn le_camera(&self, ray: &Ray) -> Vec3 {
+        match self {
+            Light::Environment(l) => l.le_camera(ray),
+            _ => self.le(ray),
         }
     }
 
@@ -99,6 +115,7 @@ impl Light {
             Light::Point(l) => l.power(),
             Light::Triangle(l) => l.power(),
             Light::Sphere(l) => l.power(),
+            Light::Environment(l) => l.power(),
         }
     }
 
@@ -108,6 +125,6 @@ impl Light {
 
     /// Whether escaped rays see this light (environment lights).
     pub fn is_infinite(&self) -> bool {
-        false
+        matches!(self, Light::Environment(_))
     }
 }
