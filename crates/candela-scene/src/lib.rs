@@ -32,8 +32,10 @@ use std::sync::Arc;
 
 use candela_core::desc::{MeshDesc, SceneDesc, Span};
 
+pub mod environment;
 pub mod obj;
 pub mod ply;
+mod toml_environment;
 pub mod toml_scene;
 mod toml_shape;
 mod toml_values;

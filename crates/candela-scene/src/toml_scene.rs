@@ -1,5 +1,5 @@
 //! Candela's TOML scene format (documented in `docs/scene-format.md`): `[render]`,
-//! `[camera]`, `[materials.NAME]`, `[[shape]]` and `[[light]]`.
+//! `[camera]`, `[materials.NAME]`, `[[shape]]`, `[[light]]` and `[environment]`.
 //!
 //! The document is first parsed into `toml`'s span-keeping tree ([`DeTable`]); each section
 //! is then deserialized on its own with `deny_unknown_fields`, so every error (unknown
@@ -19,6 +19,7 @@ use serde::Deserialize;
 use toml::de::{DeTable, DeValue, ValueDeserializer};
 use toml::Spanned;
 
+use crate::toml_environment::parse_environment;
 use crate::toml_shape::parse_shape;
 use crate::toml_values::{Num, Splat3, V3};
 use crate::{LoadError, Source};
@@ -44,6 +45,7 @@ pub fn parse_toml_scene(text: &str, file: &Path) -> Result<SceneDesc, LoadError>
                     desc.shapes.push(parse_shape(&src, base, item)?);
                 }
             }
+            "environment" => desc.environment = Some(parse_environment(&src, base, key_at, value)?),
             "light" => {
                 for item in array_of_tables(&src, "light", value)? {
                     desc.lights.push(parse_light(&src, item)?);
@@ -54,7 +56,7 @@ pub fn parse_toml_scene(text: &str, file: &Path) -> Result<SceneDesc, LoadError>
                     key_at,
                     format!(
                         "unknown key `{other}`, expected one of `render`, `camera`, \
-                         `materials`, `shape`, `light`"
+                         `materials`, `shape`, `light`, `environment`"
                     ),
                 ))
             }
