@@ -4,6 +4,7 @@
 //! file and what is wrong), 130 interrupted (the partial image is still written), 101 an
 //! internal bug.
 
+mod ies;
 mod info;
 mod output;
 mod render;
@@ -28,6 +29,15 @@ enum Command {
     Info {
         /// Scene file (.toml).
         scene: PathBuf,
+    },
+    /// Print an IES LM-63 photometric profile's header, integrated lumens, peak intensity
+    /// and beam angle.
+    Ies {
+        /// Profile (.ies).
+        file: PathBuf,
+        /// Also draw its polar intensity curves (C0–C180 and C90–C270) into this PNG.
+        #[arg(long)]
+        plot: Option<PathBuf>,
     },
 }
 
@@ -63,6 +73,7 @@ fn main() -> ExitCode {
     let result = match cli.command {
         Command::Render(args) => render::run(args),
         Command::Info { scene } => info::run(&scene).map(|()| ExitCode::SUCCESS),
+        Command::Ies { file, plot } => ies::run(&file, plot.as_deref()).map(|()| ExitCode::SUCCESS),
     };
     match result {
         Ok(code) => code,

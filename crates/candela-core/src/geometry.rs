@@ -83,10 +83,14 @@ impl Aabb {
     /// ray grazes (pbrt-v4 §6.8.2).
     #[inline]
     pub fn hit(&self, o: Vec3, inv_d: Vec3, t_max: f32) -> Option<f32> {
-        let t0 = (self.min - o) * inv_d;
-        let t1 = (self.max - o) * inv_d;
-        let near = t0.min(t1);
-        let far = t0.max(t1) * (1.0 + 2.0 * gamma(3));
+        // Near and far planes chosen by the direction's sign (not by min/max of the two
+        // distances), so an empty box (min > max) is missed.
+        let pick = |lo: f32, hi: f32, inv: f32| if inv >= 0.0 { (lo, hi) } else { (hi, lo) };
+        let (nx, fx) = pick(self.min.x, self.max.x, inv_d.x);
+        let (ny, fy) = pick(self.min.y, self.max.y, inv_d.y);
+        let (nz, fz) = pick(self.min.z, self.max.z, inv_d.z);
+        let near = (Vec3::new(nx, ny, nz) - o) * inv_d;
+        let far = (Vec3::new(fx, fy, fz) - o) * inv_d * (1.0 + 2.0 * gamma(3));
         let t_near = near.max_element().max(0.0);
         let t_far = far.min_element().min(t_max);
         (t_near <= t_far).then_some(t_near)

@@ -3,7 +3,7 @@
 //! Every `sample_*` maps uniform `u ∈ [0,1)²` to a point of its domain; the matching
 //! `*_pdf` gives the density of that warp with respect to the domain's natural measure
 //! (solid angle for directions, area for points). Each warp is checked by the chi-square
-//! suite in `tests/chi2_warps.rs`.
+//! suite in `tests/chi2_sampling.rs`.
 
 use std::f32::consts::{FRAC_PI_2, FRAC_PI_4, PI};
 
@@ -136,7 +136,10 @@ impl AliasTable {
             .collect();
         let (mut small, mut large): (Vec<usize>, Vec<usize>) =
             (0..n).partition(|&i| scaled[i] < 1.0);
-        while let (Some(s), Some(&l)) = (small.pop(), large.last()) {
+        // Peek at both lists before taking from either: popping `small` first would lose
+        // its last entry (with q = 0) whenever round-off empties `large` first.
+        while let (Some(&s), Some(&l)) = (small.last(), large.last()) {
+            small.pop();
             bins[s].q = scaled[s] as f32;
             bins[s].alias = l as u32;
             scaled[l] -= 1.0 - scaled[s];

@@ -42,6 +42,8 @@ mod toml_values;
 
 pub use toml_scene::parse_toml_scene;
 
+pub mod ies;
+
 /// A file that could not be loaded, with where and why. Displays as
 /// `file:line:col: message`.
 #[derive(Clone, Debug, PartialEq, Eq)]

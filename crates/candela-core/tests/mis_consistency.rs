@@ -1,0 +1,241 @@
+//! The four ways of combining light sampling and BSDF sampling (balance and power
+//! heuristics, NEE only, BSDF only) estimate the same integral, so their renders of the
+//! Cornell box must agree up to noise.
+//!
+//! Method: each mode renders the 64×64 box K = 8 times with different seeds at 16 spp.
+//! For each of the 8×8 tiles, the tile's mean luminance in each render is one
+//! observation; Welch's t-test compares the K observations of a mode with those of the
+//! balance heuristic. α = 0.001 per tile; with 64 independent tiles per comparison the
+//! number of false rejections is Binomial(64, 0.001), and P(X ≥ 3) ≈ 4·10⁻⁵, so up to 2
+//! failing tiles are allowed per comparison. A second test shows that a 5% bias (the
+//! light's emission scaled by 1.05) fails far more tiles than that.
+
+use std::sync::atomic::AtomicBool;
+
+use candela_core::build::build;
+use candela_core::chi2::ln_gamma;
+use candela_core::desc::*;
+use candela_core::integrator::render;
+use candela_core::math::luminance;
+use glam::{Mat4, Vec3};
+
+const RES: u32 = 64;
+const TILE: u32 = 8;
+const RENDERS: u64 = 8;
+const SPP: u32 = 16;
+const ALPHA: f64 = 0.001;
+const ALLOWED_FAILURES: usize = 2;
+
+/// Quads of the Cornell box (scenes/cornell/*.obj, metres): material, emission, corners.
+fn cornell(mis: MisMode, light_scale: f32) -> SceneDesc {
+    #[rustfmt::skip]
+    let quads: [(&str, [[f32; 3]; 4]); 16] = [
+        ("white", [[0.5528, 0.0, 0.0], [0.0, 0.0, 0.0], [0.0, 0.0, 0.5592], [0.5496, 0.0, 0.5592]]),
+        ("white", [[0.556, 0.5488, 0.0], [0.556, 0.5488, 0.5592], [0.0, 0.5488, 0.5592], [0.0, 0.5488, 0.0]]),
+        ("white", [[0.5496, 0.0, 0.5592], [0.0, 0.0, 0.5592], [0.0, 0.5488, 0.5592], [0.556, 0.5488, 0.5592]]),
+        ("green", [[0.0, 0.0, 0.5592], [0.0, 0.0, 0.0], [0.0, 0.5488, 0.0], [0.0, 0.5488, 0.5592]]),
+        ("red", [[0.5528, 0.0, 0.0], [0.5496, 0.0, 0.5592], [0.556, 0.5488, 0.5592], [0.556, 0.5488, 0.0]]),
+        ("light", [[0.343, 0.5487, 0.227], [0.343, 0.5487, 0.332], [0.213, 0.5487, 0.332], [0.213, 0.5487, 0.227]]),
+        // short block
+        ("white", [[0.13, 0.165, 0.065], [0.082, 0.165, 0.225], [0.24, 0.165, 0.272], [0.29, 0.165, 0.114]]),
+        ("white", [[0.29, 0.0, 0.114], [0.29, 0.165, 0.114], [0.24, 0.165, 0.272], [0.24, 0.0, 0.272]]),
+        ("white", [[0.13, 0.0, 0.065], [0.13, 0.165, 0.065], [0.29, 0.165, 0.114], [0.29, 0.0, 0.114]]),
+        ("white", [[0.082, 0.0, 0.225], [0.082, 0.165, 0.225], [0.13, 0.165, 0.065], [0.13, 0.0, 0.065]]),
+        ("white", [[0.24, 0.0, 0.272], [0.24, 0.165, 0.272], [0.082, 0.165, 0.225], [0.082, 0.0, 0.225]]),
+        // tall block
+        ("white", [[0.423, 0.33, 0.247], [0.265, 0.33, 0.296], [0.314, 0.33, 0.456], [0.472, 0.33, 0.406]]),
+        ("white", [[0.423, 0.0, 0.247], [0.423, 0.33, 0.247], [0.472, 0.33, 0.406], [0.472, 0.0, 0.406]]),
+        ("white", [[0.472, 0.0, 0.406], [0.472, 0.33, 0.406], [0.314, 0.33, 0.456], [0.314, 0.0, 0.456]]),
+        ("white", [[0.314, 0.0, 0.456], [0.314, 0.33, 0.456], [0.265, 0.33, 0.296], [0.265, 0.0, 0.296]]),
+        ("white", [[0.265, 0.0, 0.296], [0.265, 0.33, 0.296], [0.423, 0.33, 0.247], [0.423, 0.0, 0.247]]),
+    ];
+    let mut desc = SceneDesc {
+        camera: CameraDesc {
+            position: Vec3::new(0.278, 0.273, -0.8),
+            look_at: Vec3::new(0.278, 0.273, 0.0),
+            up: Vec3::Y,
+            fov_y_deg: 39.3077,
+            span: Span::code(),
+        },
+        render: RenderSettings {
+            width: RES,
+            height: RES,
+            spp: SPP,
+            max_depth: 8,
+            seed: 0,
+            mis,
+            light_sampler: LightSamplerKind::Power,
+        },
+        ..Default::default()
+    };
+    for (name, albedo) in [
+        ("white", Vec3::new(0.725, 0.71, 0.68)),
+        ("red", Vec3::new(0.63, 0.065, 0.05)),
+        ("green", Vec3::new(0.14, 0.45, 0.091)),
+        ("light", Vec3::new(0.725, 0.71, 0.68)),
+    ] {
+        desc.materials.push(MaterialDesc {
+            name: name.into(),
+            bsdf: BsdfDesc::Diffuse {
+                albedo: TextureDesc::Constant(albedo),
+            },
+            span: Span::code(),
+        });
+    }
+    for (material, q) in &quads {
+        desc.shapes.push(ShapeDesc {
+            geometry: GeometryDesc::Mesh(MeshDesc {
+                positions: q.iter().map(|&p| Vec3::from_array(p)).collect(),
+                indices: vec![[0, 1, 2], [0, 2, 3]],
+                ..Default::default()
+            }),
+            material: material.to_string(),
+            emission: (*material == "light").then(|| Vec3::new(17.0, 12.0, 4.0) * light_scale),
+            transform: Mat4::IDENTITY,
+            flip_normals: false,
+            span: Span::code(),
+        });
+    }
+    desc
+}
+
+/// Per tile, the tile's mean luminance in each of the independent renders.
+fn tile_means(mis: MisMode, light_scale: f32, seed_base: u64) -> Vec<Vec<f64>> {
+    let tiles = (RES / TILE) as usize;
+    let mut out = vec![Vec::new(); tiles * tiles];
+    for k in 0..RENDERS {
+        let mut desc = cornell(mis, light_scale);
+        desc.render.seed = seed_base + k;
+        let scene = build(&desc).expect("Cornell box builds");
+        let film = render(&scene, 0..SPP, &AtomicBool::new(false), &|_| {}).film;
+        let img = film.resolve();
+        let mut sums = vec![0.0f64; tiles * tiles];
+        for (i, v) in img.iter().enumerate() {
+            let (x, y) = (i as u32 % RES, i as u32 / RES);
+            sums[((y / TILE) * (RES / TILE) + x / TILE) as usize] += luminance(*v) as f64;
+        }
+        for (t, s) in sums.iter().enumerate() {
+            out[t].push(s / (TILE * TILE) as f64);
+        }
+    }
+    out
+}
+
+fn mean_var(x: &[f64]) -> (f64, f64) {
+    let n = x.len() as f64;
+    let m = x.iter().sum::<f64>() / n;
+    (
+        m,
+        x.iter().map(|v| (v - m).powi(2)).sum::<f64>() / (n - 1.0),
+    )
+}
+
+/// Regularized incomplete beta function I_x(a, b) (Numerical Recipes §6.4).
+fn beta_inc(a: f64, b: f64, x: f64) -> f64 {
+    if x <= 0.0 {
+        return 0.0;
+    }
+    if x >= 1.0 {
+        return 1.0;
+    }
+    let front =
+        (ln_gamma(a + b) - ln_gamma(a) - ln_gamma(b) + a * x.ln() + b * (1.0 - x).ln()).exp();
+    // The continued fraction converges fast for x < (a+1)/(a+b+2); use symmetry otherwise.
+    if x > (a + 1.0) / (a + b + 2.0) {
+        return 1.0 - beta_inc(b, a, 1.0 - x);
+    }
+    let tiny = 1e-300;
+    let (mut c, mut d) = (1.0, 1.0 - (a + b) * x / (a + 1.0));
+    d = 1.0 / if d.abs() < tiny { tiny } else { d };
+    let mut h = d;
+    for m in 1..1000 {
+        let m = m as f64;
+        for num in [
+            m * (b - m) * x / ((a + 2.0 * m - 1.0) * (a + 2.0 * m)),
+            -(a + m) * (a + b + m) * x / ((a + 2.0 * m) * (a + 2.0 * m + 1.0)),
+        ] {
+            d = 1.0 + num * d;
+            d = 1.0 / if d.abs() < tiny { tiny } else { d };
+            c = 1.0 + num / c;
+            if c.abs() < tiny {
+                c = tiny;
+            }
+            h *= d * c;
+        }
+        if (d * c - 1.0).abs() < 1e-15 {
+            break;
+        }
+    }
+    front * h / a
+}
+
+/// Two-sided p-value of Welch's t-test between two samples.
+fn welch_p(x: &[f64], y: &[f64]) -> f64 {
+    let ((mx, vx), (my, vy)) = (mean_var(x), mean_var(y));
+    let (sx, sy) = (vx / x.len() as f64, vy / y.len() as f64);
+    if sx + sy == 0.0 {
+        return if mx == my { 1.0 } else { 0.0 };
+    }
+    let t = (mx - my) / (sx + sy).sqrt();
+    let dof =
+        (sx + sy).powi(2) / (sx * sx / (x.len() as f64 - 1.0) + sy * sy / (y.len() as f64 - 1.0));
+    // P(|T| ≥ t) = I_{ν/(ν+t²)}(ν/2, 1/2).
+    beta_inc(0.5 * dof, 0.5, dof / (dof + t * t))
+}
+
+/// Tiles whose Welch test rejects equality at [`ALPHA`].
+fn failing_tiles(a: &[Vec<f64>], b: &[Vec<f64>]) -> Vec<(usize, f64)> {
+    a.iter()
+        .zip(b)
+        .enumerate()
+        .map(|(i, (x, y))| (i, welch_p(x, y)))
+        .filter(|&(_, p)| p < ALPHA)
+        .collect()
+}
+
+#[test]
+fn welch_p_matches_student_t_tables() {
+    // t(0.975; ν = 10) = 2.228139, so a two-sided p of 0.05; t(0.995; 5) = 4.032143.
+    let p = |t: f64, nu: f64| beta_inc(0.5 * nu, 0.5, nu / (nu + t * t));
+    assert!((p(2.228_139, 10.0) - 0.05).abs() < 1e-5);
+    assert!((p(4.032_143, 5.0) - 0.01).abs() < 1e-5);
+    assert!((p(0.0, 7.0) - 1.0).abs() < 1e-12);
+}
+
+#[test]
+#[ignore = "slow statistical test; CI runs it"]
+fn mis_modes_agree_on_the_cornell_box() {
+    let balance = tile_means(MisMode::Balance, 1.0, 1000);
+    for (mis, seed) in [
+        (MisMode::Power, 2000),
+        (MisMode::NeeOnly, 3000),
+        (MisMode::BsdfOnly, 4000),
+    ] {
+        let other = tile_means(mis, 1.0, seed);
+        let fails = failing_tiles(&balance, &other);
+        eprintln!(
+            "{mis:?} vs Balance: {} of 64 tiles fail at α = {ALPHA}",
+            fails.len()
+        );
+        assert!(
+            fails.len() <= ALLOWED_FAILURES,
+            "{mis:?} disagrees with the balance heuristic in tiles (index, p) {fails:?}"
+        );
+    }
+}
+
+#[test]
+#[ignore = "slow statistical test; CI runs it"]
+fn a_five_percent_bias_is_detected() {
+    // The same comparison against a render whose light is 5% brighter: the test above
+    // must be able to fail.
+    let balance = tile_means(MisMode::Balance, 1.0, 1000);
+    let brighter = tile_means(MisMode::NeeOnly, 1.05, 3000);
+    let fails = failing_tiles(&balance, &brighter);
+    eprintln!("light × 1.05: {} of 64 tiles fail", fails.len());
+    assert!(
+        fails.len() > 8 * ALLOWED_FAILURES,
+        "only {} tiles detect the bias",
+        fails.len()
+    );
+}
