@@ -116,6 +116,21 @@ pub fn split_cross(img: &ImageDesc) -> Result<[ImageDesc; 6], String> {
     }
 }
 
+/// The image turned upside down: for cube map faces stored bottom row first.
+pub fn flip_vertical(img: &ImageDesc) -> ImageDesc {
+    let w = img.width as usize;
+    ImageDesc {
+        pixels: img
+            .pixels
+            .chunks_exact(w)
+            .rev()
+            .flatten()
+            .copied()
+            .collect(),
+        ..*img
+    }
+}
+
 /// Loads six face files in the order +x, −x, +y, −y, +z, −z, checking that they are
 /// square and of one size. Errors name the face's index.
 pub fn load_cube_faces(paths: &[&Path; 6]) -> Result<[ImageDesc; 6], (usize, String)> {

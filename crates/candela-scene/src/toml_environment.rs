@@ -5,13 +5,13 @@
 use std::fmt;
 use std::path::{Path, PathBuf};
 
-use candela_core::desc::{EnvironmentDesc, EnvironmentMapDesc};
+use candela_core::desc::{EnvironmentDesc, EnvironmentMapDesc, ImageDesc};
 use glam::{Mat3, Vec3};
 use serde::de::{self, Deserializer, MapAccess, Visitor};
 use serde::Deserialize;
 use toml::Spanned;
 
-use crate::environment::{load_cube_faces, load_linear_image, split_cross};
+use crate::environment::{flip_vertical, load_cube_faces, load_linear_image, split_cross};
 use crate::toml_scene::{deserialize, Item};
 use crate::toml_shape::{compose, TransformOp};
 use crate::toml_values::{Num, Splat3};
@@ -61,11 +61,20 @@ impl<'de> Deserialize<'de> for CubemapSpec {
     }
 }
 
+fn flip_faces(faces: [ImageDesc; 6], flip: bool) -> [ImageDesc; 6] {
+    if flip {
+        faces.map(|f| flip_vertical(&f))
+    } else {
+        faces
+    }
+}
+
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
 struct EnvironmentSection {
     equirect: Option<Spanned<String>>,
     cubemap: Option<Spanned<CubemapSpec>>,
+    flip_faces: Option<Spanned<bool>>,
     constant: Option<Spanned<Splat3>>,
     strength: Option<Num>,
     rotation: Option<Spanned<Num>>,
@@ -82,20 +91,24 @@ pub(crate) fn parse_environment(
     key_at: usize,
     value: Item,
 ) -> Result<EnvironmentDesc, LoadError> {
-    let at = value.span().start;
     let e: EnvironmentSection = deserialize(src, value)?;
     let sources = [
         e.equirect.as_ref().map(|s| s.span().start),
         e.cubemap.as_ref().map(|s| s.span().start),
         e.constant.as_ref().map(|s| s.span().start),
     ];
-    let given: Vec<usize> = sources.iter().flatten().copied().collect();
+    let mut given: Vec<usize> = sources.iter().flatten().copied().collect();
+    given.sort_unstable(); // point at the second one in the file
     if given.len() != 1 {
         return Err(src.error(
-            given.get(1).copied().unwrap_or(at),
+            given.get(1).copied().unwrap_or(key_at),
             "`[environment]` needs exactly one of `equirect`, `cubemap`, `constant`",
         ));
     }
+    if let (Some(f), None) = (&e.flip_faces, &e.cubemap) {
+        return Err(src.error(f.span().start, "`flip_faces` applies only to a `cubemap`"));
+    }
+    let flip = e.flip_faces.map_or(false, |f| f.into_inner());
     let resolve = |p: &str| -> PathBuf { base.join(p) };
     let map = if let Some(file) = e.equirect {
         let at = file.span().start;
@@ -109,7 +122,7 @@ pub(crate) fn parse_environment(
                 let img = load_linear_image(&resolve(&file))
                     .and_then(|img| split_cross(&img))
                     .map_err(|m| src.error(at, format!("{file}: {m}")))?;
-                EnvironmentMapDesc::Cubemap(Box::new(img))
+                EnvironmentMapDesc::Cubemap(Box::new(flip_faces(img, flip)))
             }
             CubemapSpec::Faces(files) => {
                 let paths: Vec<PathBuf> = files.iter().map(|f| resolve(f)).collect();
@@ -117,7 +130,7 @@ pub(crate) fn parse_environment(
                 let faces = load_cube_faces(&refs).map_err(|(i, m)| {
                     src.error(at, format!("face {} ({}): {m}", FACE_KEYS[i], files[i]))
                 })?;
-                EnvironmentMapDesc::Cubemap(Box::new(faces))
+                EnvironmentMapDesc::Cubemap(Box::new(flip_faces(faces, flip)))
             }
         }
     } else {

@@ -134,4 +134,41 @@ impl EnvironmentLight {
     pub fn power(&self) -> f32 {
         PI * self.scene_radius * self.scene_radius * self.luminance_integral
     }
+
+    /// Fraction of the map's power (luminance × texel solid angle) carried by its
+    /// brightest `fraction` of texels: near `fraction` for an even sky, near 1 for a
+    /// small sun. A measure of how much importance sampling matters.
+    pub fn peak_fraction(&self, fraction: f32) -> f32 {
+        let mut power: Vec<f32> = match &self.map {
+            EnvironmentMap::Constant(_) => return fraction.clamp(0.0, 1.0),
+            EnvironmentMap::Equirect(m) => {
+                let (w, h) = (m.image.width, m.image.height);
+                m.image
+                    .pixels
+                    .iter()
+                    .enumerate()
+                    .map(|(i, p)| luminance(*p) * (PI * ((i / w) as f32 + 0.5) / h as f32).sin())
+                    .collect()
+            }
+            EnvironmentMap::Cubemap(m) => m
+                .faces
+                .iter()
+                .flat_map(|f| {
+                    let n = f.width;
+                    f.pixels.iter().enumerate().map(move |(i, p)| {
+                        let a = 2.0 * ((i % n) as f32 + 0.5) / n as f32 - 1.0;
+                        let b = 2.0 * ((i / n) as f32 + 0.5) / n as f32 - 1.0;
+                        luminance(*p) * (1.0 + a * a + b * b).powf(-1.5)
+                    })
+                })
+                .collect(),
+        };
+        let total: f64 = power.iter().map(|&p| p as f64).sum();
+        if total <= 0.0 {
+            return 0.0;
+        }
+        power.sort_unstable_by(|a, b| b.total_cmp(a));
+        let k = ((fraction.clamp(0.0, 1.0) * power.len() as f32).ceil() as usize).max(1);
+        (power[..k].iter().map(|&p| p as f64).sum::<f64>() / total) as f32
+    }
 }
