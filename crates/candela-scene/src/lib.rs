@@ -35,6 +35,7 @@ use candela_core::desc::{MeshDesc, SceneDesc, Span};
 pub mod environment;
 pub mod obj;
 pub mod ply;
+mod toml_camera;
 mod toml_environment;
 pub mod toml_scene;
 mod toml_shape;
