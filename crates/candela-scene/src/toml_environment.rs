@@ -108,7 +108,7 @@ pub(crate) fn parse_environment(
     if let (Some(f), None) = (&e.flip_faces, &e.cubemap) {
         return Err(src.error(f.span().start, "`flip_faces` applies only to a `cubemap`"));
     }
-    let flip = e.flip_faces.map_or(false, |f| f.into_inner());
+    let flip = e.flip_faces.is_some_and(|f| f.into_inner());
     let resolve = |p: &str| -> PathBuf { base.join(p) };
     let map = if let Some(file) = e.equirect {
         let at = file.span().start;
