@@ -193,7 +193,7 @@ pub fn build(desc: &SceneDesc) -> Result<Scene, BuildError> {
         };
         lights.push(Light::Environment(build_environment(env, radius)?));
     }
-    let light_sampler = LightSampler::new(r.light_sampler, &lights);
+    let light_sampler = LightSampler::new(r.light_sampler, r.ris_candidates, &lights);
     let infinite_lights = lights
         .iter()
         .enumerate()

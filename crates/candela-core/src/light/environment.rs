@@ -135,6 +135,13 @@ impl EnvironmentLight {
         PI * self.scene_radius * self.scene_radius * self.luminance_integral
     }
 
+    /// Potential contribution at any point, for light selection: ∫ L dω over the sphere
+    /// (solid angle × brightness, with the receiver cosine bounded by 1), as for the
+    /// other lights' `importance`.
+    pub fn importance(&self) -> f32 {
+        self.luminance_integral
+    }
+
     /// Fraction of the map's power (luminance × texel solid angle) carried by its
     /// brightest `fraction` of texels: near `fraction` for an even sky, near 1 for a
     /// small sun. A measure of how much importance sampling matters.
