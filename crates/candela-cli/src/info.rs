@@ -2,7 +2,7 @@
 
 use std::path::Path;
 
-use candela_core::light::Light;
+use candela_core::light::{EnvironmentLight, EnvironmentMap, Light};
 
 use crate::UserError;
 
@@ -21,13 +21,19 @@ pub fn run(path: &Path) -> Result<(), UserError> {
     );
     println!("triangles  {}", scene.triangle_count());
     println!(
-        "lights     {} ({} emitting triangles, {} spheres, {} points), total power {:.4} W",
+        "lights     {} ({} emitting triangles, {} spheres, {} points, {} environments), total power {:.4} W",
         scene.lights.len(),
         count(|l| matches!(l, Light::Triangle(_))),
         count(|l| matches!(l, Light::Sphere(_))),
         count(|l| matches!(l, Light::Point(_))),
+        count(|l| matches!(l, Light::Environment(_))),
         scene.lights.iter().map(Light::power).sum::<f32>()
     );
+    for l in &scene.lights {
+        if let Light::Environment(env) = l {
+            print_environment(env);
+        }
+    }
     let names: Vec<&str> = desc.materials.iter().map(|m| m.name.as_str()).collect();
     println!("materials  {} ({})", names.len(), names.join(", "));
     let c = &desc.camera;
@@ -48,4 +54,32 @@ pub fn run(path: &Path) -> Result<(), UserError> {
         s.width, s.height, s.spp, s.max_depth, s.seed, s.mis, s.light_sampler
     );
     Ok(())
+}
+
+/// The environment's map, its power estimate and how peaked it is (the share of power in
+/// the brightest 1% of texels: about 0.01 for an even sky, near 1 for a small sun).
+fn print_environment(env: &EnvironmentLight) {
+    let map = match &env.map {
+        EnvironmentMap::Constant(c) => format!("constant {:?}", c.to_array()),
+        EnvironmentMap::Equirect(m) => format!("equirect {}x{}", m.image.width, m.image.height),
+        EnvironmentMap::Cubemap(m) => {
+            format!("cube map 6 x {}x{}", m.faces[0].width, m.faces[0].height)
+        }
+    };
+    println!(
+        "environment {map}, strength {}, {}",
+        env.strength,
+        if env.visible {
+            "visible".to_string()
+        } else {
+            format!("hidden (background {:?})", env.background.to_array())
+        }
+    );
+    println!(
+        "            power {:.4} W (pi r^2 * integral of L over the sphere, r = {:.3}), \
+         brightest 1% of texels hold {:.1}% of it",
+        env.power(),
+        env.scene_radius,
+        100.0 * env.peak_fraction(0.01)
+    );
 }

@@ -184,6 +184,30 @@ fn info_describes_the_scene() {
     assert!(text.contains("materials  1 (white)"), "{text}");
 }
 
+#[test]
+fn info_reports_the_environment() {
+    // A 100×50 panorama, black but for one texel: all power in the brightest 1%.
+    let (dir, scene) = scene_dir(&format!(
+        "{SCENE}\n[environment]\nequirect = \"sky.png\"\nstrength = 2\n"
+    ));
+    let mut img = image::RgbImage::new(100, 50);
+    img.put_pixel(10, 20, image::Rgb([255, 255, 255]));
+    img.save(dir.path().join("sky.png")).unwrap();
+    let o = candela(&["info", s(&scene)]);
+    let text = String::from_utf8_lossy(&o.stdout);
+    assert!(
+        o.status.success(),
+        "{text}{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    assert!(text.contains("1 environments"), "{text}");
+    assert!(
+        text.contains("environment equirect 100x50, strength 2, visible"),
+        "{text}"
+    );
+    assert!(text.contains("hold 100.0% of it"), "{text}");
+}
+
 #[cfg(unix)]
 #[test]
 fn interrupt_writes_the_partial_image() {

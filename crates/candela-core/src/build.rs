@@ -13,11 +13,13 @@ use crate::bsdf::{
 use crate::bvh::Bvh;
 use crate::camera::Camera;
 use crate::desc::{
-    ApertureDesc, ApertureSizeDesc, BsdfDesc, CameraDesc, FocusDesc, GeometryDesc, LensDesc,
-    MeshDesc, SceneDesc, ShapeDesc, Span, TextureDesc,
+    ApertureDesc, ApertureSizeDesc, BsdfDesc, CameraDesc, EnvironmentDesc, EnvironmentMapDesc,
+    FocusDesc, GeometryDesc, ImageDesc, LensDesc, MeshDesc, SceneDesc, ShapeDesc, Span,
+    TextureDesc,
 };
 use crate::geometry::Aabb;
-use crate::light::{Light, LightId, SphereLight};
+use crate::light::envmap::{Cubemap, Equirect, Image};
+use crate::light::{EnvironmentLight, EnvironmentMap, Light, LightId, SphereLight};
 use crate::light_sampler::LightSampler;
 use crate::material::{Material, MaterialId, Texture};
 use crate::scene::{Mesh, Prim, Scene, Sphere};
@@ -175,6 +177,9 @@ pub fn build(desc: &SceneDesc) -> Result<Scene, BuildError> {
             d.scene_radius = scene_radius;
         }
     }
+    if let Some(env) = &desc.environment {
+        lights.push(Light::Environment(build_environment(env, scene_radius)?));
+    }
     let light_sampler = LightSampler::new(r.light_sampler, r.ris_candidates, &lights);
     let infinite_lights = lights
         .iter()
@@ -195,6 +200,86 @@ pub fn build(desc: &SceneDesc) -> Result<Scene, BuildError> {
         prims,
         bvh,
     })
+}
+
+fn check_image(span: &Span, what: &str, img: &ImageDesc) -> Result<(), BuildError> {
+    if img.width == 0 || img.height == 0 {
+        return err(
+            span,
+            format!("{what} is empty ({}x{})", img.width, img.height),
+        );
+    }
+    if img.pixels.len() != img.width as usize * img.height as usize {
+        return err(
+            span,
+            format!(
+                "{what} has {} pixels for {}x{}",
+                img.pixels.len(),
+                img.width,
+                img.height
+            ),
+        );
+    }
+    if img
+        .pixels
+        .iter()
+        .any(|p| !p.is_finite() || p.min_element() < 0.0)
+    {
+        return err(span, format!("{what} has a negative or non-finite pixel"));
+    }
+    Ok(())
+}
+
+/// Validates an environment and makes its canonical, sampleable form.
+fn build_environment(env: &EnvironmentDesc, radius: f32) -> Result<EnvironmentLight, BuildError> {
+    let span = &env.span;
+    check_finite(span, "environment strength", &[env.strength])?;
+    if env.strength < 0.0 {
+        return err(span, "environment strength must not be negative");
+    }
+    check_color(span, "environment background", env.background)?;
+    let r = env.rotation;
+    check_finite(span, "environment rotation", &r.to_cols_array())?;
+    let off = (r.transpose() * r - Mat3::IDENTITY).abs().to_cols_array();
+    if off.iter().any(|&e| e > 1e-3) || r.determinant() < 0.0 {
+        return err(
+            span,
+            "environment rotation must be a rotation (orthonormal, det +1)",
+        );
+    }
+    let map = match &env.map {
+        EnvironmentMapDesc::Constant(c) => {
+            check_color(span, "environment constant", *c)?;
+            EnvironmentMap::Constant(*c)
+        }
+        EnvironmentMapDesc::Equirect(img) => {
+            check_image(span, "environment map", img)?;
+            EnvironmentMap::Equirect(Equirect::new(Image::from_desc(img)))
+        }
+        EnvironmentMapDesc::Cubemap(faces) => {
+            let n = faces[0].width;
+            for (f, name) in faces.iter().zip(["+x", "-x", "+y", "-y", "+z", "-z"]) {
+                let what = format!("cube map face {name}");
+                check_image(span, &what, f)?;
+                if f.width != n || f.height != n {
+                    return err(
+                        span,
+                        format!(
+                            "{what} is {}x{}; faces must be square and all {n}x{n}",
+                            f.width, f.height
+                        ),
+                    );
+                }
+            }
+            EnvironmentMap::Cubemap(Cubemap::new(Box::new(
+                faces.each_ref().map(Image::from_desc),
+            )))
+        }
+    };
+    let mut light = EnvironmentLight::new(map, env.strength, r, radius);
+    light.visible = env.visible;
+    light.background = env.background;
+    Ok(light)
 }
 
 fn build_camera(desc: &SceneDesc) -> Result<Camera, BuildError> {

@@ -9,7 +9,7 @@
 use std::fmt;
 use std::sync::Arc;
 
-use glam::{Affine2, Mat4, Vec2, Vec3};
+use glam::{Affine2, Mat3, Mat4, Vec2, Vec3};
 
 /// Where an item of a description came from: `file:line:col` (1-based). Items made in code
 /// have an empty file name and line 0.
@@ -53,6 +53,8 @@ pub struct SceneDesc {
     pub materials: Vec<MaterialDesc>,
     pub shapes: Vec<ShapeDesc>,
     pub lights: Vec<LightDesc>,
+    /// The sky: what escaped rays see and what lights the scene from infinitely far.
+    pub environment: Option<EnvironmentDesc>,
     pub render: RenderSettings,
     /// Goniometric profiles attached to emitting shapes (IES-shaped area lights).
     pub emission_profiles: Vec<EmissionProfileDesc>,
@@ -430,6 +432,47 @@ pub struct EmissionProfileDesc {
     pub shape: usize,
     pub table: Arc<crate::photometry::GoniometricTable>,
     pub span: Span,
+}
+
+/// An environment light: radiance arriving from infinitely far away, by direction.
+#[derive(Clone, Debug)]
+pub struct EnvironmentDesc {
+    pub map: EnvironmentMapDesc,
+    /// Scales the map's radiance.
+    pub strength: f32,
+    /// World from map: a rotation applied to the map's native directions.
+    pub rotation: Mat3,
+    /// Whether camera rays see the map; when `false` they see `background` instead, while
+    /// the map still lights the scene.
+    pub visible: bool,
+    /// What camera rays see when the map is not visible (linear radiance).
+    pub background: Vec3,
+    pub span: Span,
+}
+
+impl Default for EnvironmentDesc {
+    fn default() -> Self {
+        EnvironmentDesc {
+            map: EnvironmentMapDesc::Constant(Vec3::ONE),
+            strength: 1.0,
+            rotation: Mat3::IDENTITY,
+            visible: true,
+            background: Vec3::ZERO,
+            span: Span::code(),
+        }
+    }
+}
+
+/// The radiance of an environment by direction. Images are decoded to linear RGB by the
+/// loaders; the mappings are documented in `light::envmap`.
+#[derive(Clone, Debug)]
+pub enum EnvironmentMapDesc {
+    /// The same radiance from every direction.
+    Constant(Vec3),
+    /// A latitude-longitude panorama, 2:1 or any aspect.
+    Equirect(ImageDesc),
+    /// Six square faces of equal size in the order +x, −x, +y, −y, +z, −z.
+    Cubemap(Box<[ImageDesc; 6]>),
 }
 
 /// How to weigh next event estimation against BSDF sampling.

@@ -168,7 +168,12 @@ pub fn li<S: Sampler>(scene: &Scene, mut ray: Ray, sampler: &mut S, rays: &mut u
         *rays += 1;
         let Some(si) = scene.intersect(&ray, f32::INFINITY) else {
             for &id in &scene.infinite_lights {
-                let le = scene.light(id).le(&ray);
+                let light = scene.light(id);
+                let le = if depth == 0 {
+                    light.le_camera(&ray)
+                } else {
+                    light.le(&ray)
+                };
                 if le != Vec3::ZERO {
                     l += beta * le * emitter_weight(specular, &prev_ctx, prev_bsdf_pdf, id, ray.d);
                 }

@@ -32,10 +32,12 @@ use std::sync::Arc;
 
 use candela_core::desc::{MeshDesc, SceneDesc, Span};
 
+pub mod environment;
 pub mod image_texture;
 pub mod obj;
 pub mod ply;
 mod toml_camera;
+mod toml_environment;
 mod toml_light;
 mod toml_material;
 pub mod toml_scene;

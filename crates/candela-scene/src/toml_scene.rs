@@ -1,5 +1,5 @@
 //! Candela's TOML scene format (documented in `docs/scene-format.md`): `[render]`,
-//! `[camera]`, `[materials.NAME]`, `[[shape]]` and `[[light]]`.
+//! `[camera]`, `[materials.NAME]`, `[[shape]]`, `[[light]]` and `[environment]`.
 //!
 //! The document is first parsed into `toml`'s span-keeping tree ([`DeTable`]); each section
 //! is then deserialized on its own with `deny_unknown_fields`, so every error (unknown
@@ -18,6 +18,7 @@ use toml::de::{DeTable, DeValue, ValueDeserializer};
 use toml::Spanned;
 
 use crate::toml_camera::parse_camera;
+use crate::toml_environment::parse_environment;
 use crate::toml_light::parse_light;
 use crate::toml_material::{parse_material, MATERIAL_TYPES};
 use crate::toml_shape::parse_shape;
@@ -52,6 +53,7 @@ pub fn parse_toml_scene(text: &str, file: &Path) -> Result<SceneDesc, LoadError>
                     desc.shapes.push(shape);
                 }
             }
+            "environment" => desc.environment = Some(parse_environment(&src, base, key_at, value)?),
             "light" => {
                 for item in array_of_tables(&src, "light", value)? {
                     desc.lights.push(parse_light(&src, base, item)?);
@@ -62,7 +64,7 @@ pub fn parse_toml_scene(text: &str, file: &Path) -> Result<SceneDesc, LoadError>
                     key_at,
                     format!(
                         "unknown key `{other}`, expected one of `render`, `camera`, \
-                         `materials`, `shape`, `light`"
+                         `materials`, `shape`, `light`, `environment`"
                     ),
                 ))
             }

@@ -18,7 +18,7 @@ use crate::{load_mesh, LoadError, Source};
 /// One step of a `transform` list: a one-key inline table such as `{ translate = [...] }`.
 #[derive(Deserialize)]
 #[serde(rename_all = "snake_case", deny_unknown_fields)]
-enum TransformOp {
+pub(crate) enum TransformOp {
     Translate(V3),
     /// Right-handed rotation about `axis` by `angle` degrees.
     Rotate {
@@ -82,7 +82,7 @@ pub(crate) fn look_at(origin: Vec3, target: Vec3, up: Vec3) -> Option<Mat4> {
 }
 
 /// Composes a `transform` list; the first item is applied to the object first.
-fn compose(src: &Source, ops: Vec<Spanned<TransformOp>>) -> Result<Mat4, LoadError> {
+pub(crate) fn compose(src: &Source, ops: Vec<Spanned<TransformOp>>) -> Result<Mat4, LoadError> {
     let mut m = Mat4::IDENTITY;
     for op in ops {
         m = op_matrix(src, op)? * m;

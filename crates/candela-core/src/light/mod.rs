@@ -15,6 +15,8 @@ pub mod blackbody;
 mod bounds;
 mod directional;
 mod goniometric;
+mod environment;
+pub mod envmap;
 mod point;
 mod profile;
 mod projector;
@@ -25,6 +27,7 @@ mod triangle;
 pub use bounds::{cone_measure, cone_union, ImportanceBounds, LightBounds};
 pub use directional::DirectionalLight;
 pub use goniometric::GoniometricLight;
+pub use environment::{EnvironmentLight, EnvironmentMap, EnvironmentSampling};
 pub use point::PointLight;
 pub use profile::LightProfile;
 pub use projector::ProjectorLight;
@@ -83,6 +86,7 @@ pub enum Light {
     Goniometric(GoniometricLight),
     Directional(DirectionalLight),
     Projector(ProjectorLight),
+    Environment(EnvironmentLight),
 }
 
 impl Light {
@@ -95,6 +99,7 @@ impl Light {
             Light::Goniometric(l) => l.sample_li(ctx),
             Light::Directional(l) => l.sample_li(ctx),
             Light::Projector(l) => l.sample_li(ctx),
+            Light::Environment(l) => l.sample_li(ctx, u),
         }?;
         (s.pdf > 0.0 && s.pdf.is_finite() && s.radiance != Vec3::ZERO).then_some(s)
     }
@@ -109,6 +114,7 @@ impl Light {
             | Light::Projector(_) => 0.0,
             Light::Triangle(l) => l.pdf_li(ctx, wi),
             Light::Sphere(l) => l.pdf_li(ctx, wi),
+            Light::Environment(l) => l.pdf_li(ctx, wi),
         }
     }
 
@@ -119,15 +125,28 @@ impl Light {
             | Light::Spot(_)
             | Light::Goniometric(_)
             | Light::Directional(_)
-            | Light::Projector(_) => Vec3::ZERO,
+            | Light::Projector(_)
+            | Light::Environment(_) => Vec3::ZERO,
             Light::Triangle(l) => l.radiance(n, w),
             Light::Sphere(l) => l.radiance(n, w),
         }
     }
 
     /// Radiance an infinite light sends along an escaped ray.
-    pub fn le(&self, _ray: &Ray) -> Vec3 {
-        Vec3::ZERO
+    pub fn le(&self, ray: &Ray) -> Vec3 {
+        match self {
+            Light::Environment(l) => l.le(ray),
+            _ => Vec3::ZERO,
+        }
+    }
+
+    /// What an escaped camera ray sees of an infinite light: [`Self::le`], unless the
+    /// light is hidden from the camera.
+    pub fn le_camera(&self, ray: &Ray) -> Vec3 {
+        match self {
+            Light::Environment(l) => l.le_camera(ray),
+            _ => self.le(ray),
+        }
     }
 
     /// Total emitted power Φ, as a luminance-weighted scalar (W).
@@ -140,6 +159,7 @@ impl Light {
             Light::Goniometric(l) => l.power(),
             Light::Directional(l) => l.power(),
             Light::Projector(l) => l.power(),
+            Light::Environment(l) => l.power(),
         }
     }
 
@@ -157,6 +177,7 @@ impl Light {
             Light::Goniometric(l) => l.importance(ctx),
             Light::Directional(l) => l.importance(ctx),
             Light::Projector(l) => l.importance(ctx),
+            Light::Environment(l) => l.importance(),
         }
     }
 
@@ -171,6 +192,7 @@ impl Light {
             Light::Goniometric(l) => Some(l.bounds()),
             Light::Projector(l) => Some(l.bounds()),
             Light::Directional(_) => None,
+            Light::Environment(_) => None,
         }
     }
 
@@ -187,6 +209,6 @@ impl Light {
 
     /// Whether escaped rays see this light (environment lights).
     pub fn is_infinite(&self) -> bool {
-        false
+        matches!(self, Light::Environment(_))
     }
 }

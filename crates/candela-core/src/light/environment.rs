@@ -1,0 +1,181 @@
+//! The environment light: radiance arriving from infinitely far away, looked up by
+//! direction alone. Escaped rays read it ([`EnvironmentLight::le`]); next event estimation
+//! samples it in proportion to its filtered radiance, and shadow rays towards it go to
+//! infinity.
+
+use std::f32::consts::PI;
+
+use glam::{Mat3, Vec2, Vec3};
+
+use super::envmap::{Cubemap, Equirect};
+use super::{LightSample, ShadingCtx};
+use crate::geometry::Ray;
+use crate::math::luminance;
+use crate::sampling::sample_uniform_sphere;
+
+/// What the environment looks like, in its native frame.
+#[derive(Clone, Debug)]
+pub enum EnvironmentMap {
+    Constant(Vec3),
+    Equirect(Equirect),
+    Cubemap(Cubemap),
+}
+
+/// How [`EnvironmentLight::sample_li`] picks directions. Importance is the default; the
+/// uniform strategy exists to measure what importance sampling buys.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum EnvironmentSampling {
+    #[default]
+    Importance,
+    /// Uniform over the sphere, whatever the map.
+    Uniform,
+}
+
+#[derive(Clone, Debug)]
+pub struct EnvironmentLight {
+    pub map: EnvironmentMap,
+    pub strength: f32,
+    /// World from map (a rotation), and its inverse.
+    pub world_from_map: Mat3,
+    pub map_from_world: Mat3,
+    pub visible: bool,
+    pub background: Vec3,
+    pub sampling: EnvironmentSampling,
+    /// Radius of the scene's bounding sphere, for [`Self::power`].
+    pub scene_radius: f32,
+    /// ∫ luminance(L) dω over the sphere, strength included.
+    pub luminance_integral: f32,
+}
+
+impl EnvironmentLight {
+    pub fn new(
+        map: EnvironmentMap,
+        strength: f32,
+        world_from_map: Mat3,
+        scene_radius: f32,
+    ) -> EnvironmentLight {
+        let integral = match &map {
+            EnvironmentMap::Constant(c) => 4.0 * PI * luminance(*c),
+            EnvironmentMap::Equirect(m) => m.luminance_integral(),
+            EnvironmentMap::Cubemap(m) => m.luminance_integral(),
+        };
+        EnvironmentLight {
+            map,
+            strength,
+            world_from_map,
+            map_from_world: world_from_map.transpose(),
+            visible: true,
+            background: Vec3::ZERO,
+            sampling: EnvironmentSampling::Importance,
+            scene_radius,
+            luminance_integral: strength * integral,
+        }
+    }
+
+    /// Radiance arriving along `-d` from direction `d` (world space, unit).
+    pub fn eval(&self, d: Vec3) -> Vec3 {
+        let local = self.map_from_world * d;
+        self.strength
+            * match &self.map {
+                EnvironmentMap::Constant(c) => *c,
+                EnvironmentMap::Equirect(m) => m.eval(local),
+                EnvironmentMap::Cubemap(m) => m.eval(local),
+            }
+    }
+
+    /// Radiance along an escaped ray.
+    pub fn le(&self, ray: &Ray) -> Vec3 {
+        self.eval(ray.d.normalize())
+    }
+
+    /// What a camera ray that escapes sees: the map, or the background when hidden.
+    pub fn le_camera(&self, ray: &Ray) -> Vec3 {
+        if self.visible {
+            self.le(ray)
+        } else {
+            self.background
+        }
+    }
+
+    pub fn sample_li(&self, _ctx: &ShadingCtx, u: Vec2) -> Option<LightSample> {
+        let (local, pdf) = match (&self.map, self.sampling) {
+            (EnvironmentMap::Constant(_), _) | (_, EnvironmentSampling::Uniform) => {
+                (sample_uniform_sphere(u), 1.0 / (4.0 * PI))
+            }
+            (EnvironmentMap::Equirect(m), _) => m.sample(u)?,
+            (EnvironmentMap::Cubemap(m), _) => m.sample(u)?,
+        };
+        let wi = (self.world_from_map * local).normalize();
+        Some(LightSample {
+            radiance: self.eval(wi),
+            wi,
+            distance: f32::INFINITY,
+            pdf,
+            is_delta: false,
+            p_light: wi,
+            n_light: Vec3::ZERO,
+        })
+    }
+
+    pub fn pdf_li(&self, _ctx: &ShadingCtx, wi: Vec3) -> f32 {
+        let local = self.map_from_world * wi.normalize();
+        match (&self.map, self.sampling) {
+            (EnvironmentMap::Constant(_), _) | (_, EnvironmentSampling::Uniform) => {
+                1.0 / (4.0 * PI)
+            }
+            (EnvironmentMap::Equirect(m), _) => m.pdf(local),
+            (EnvironmentMap::Cubemap(m), _) => m.pdf(local),
+        }
+    }
+
+    /// Power Φ the scene receives: as pbrt-v4's `ImageInfiniteLight::Phi`, the flux
+    /// through a disk of the scene's bounding radius r, averaged over orientations,
+    /// Φ = π r² ∫ L dω (luminance-weighted).
+    pub fn power(&self) -> f32 {
+        PI * self.scene_radius * self.scene_radius * self.luminance_integral
+    }
+
+    /// Potential contribution at any point, for light selection: ∫ L dω over the sphere
+    /// (solid angle × brightness, with the receiver cosine bounded by 1), as for the
+    /// other lights' `importance`.
+    pub fn importance(&self) -> f32 {
+        self.luminance_integral
+    }
+
+    /// Fraction of the map's power (luminance × texel solid angle) carried by its
+    /// brightest `fraction` of texels: near `fraction` for an even sky, near 1 for a
+    /// small sun. A measure of how much importance sampling matters.
+    pub fn peak_fraction(&self, fraction: f32) -> f32 {
+        let mut power: Vec<f32> = match &self.map {
+            EnvironmentMap::Constant(_) => return fraction.clamp(0.0, 1.0),
+            EnvironmentMap::Equirect(m) => {
+                let (w, h) = (m.image.width, m.image.height);
+                m.image
+                    .pixels
+                    .iter()
+                    .enumerate()
+                    .map(|(i, p)| luminance(*p) * (PI * ((i / w) as f32 + 0.5) / h as f32).sin())
+                    .collect()
+            }
+            EnvironmentMap::Cubemap(m) => m
+                .faces
+                .iter()
+                .flat_map(|f| {
+                    let n = f.width;
+                    f.pixels.iter().enumerate().map(move |(i, p)| {
+                        let a = 2.0 * ((i % n) as f32 + 0.5) / n as f32 - 1.0;
+                        let b = 2.0 * ((i / n) as f32 + 0.5) / n as f32 - 1.0;
+                        luminance(*p) * (1.0 + a * a + b * b).powf(-1.5)
+                    })
+                })
+                .collect(),
+        };
+        let total: f64 = power.iter().map(|&p| p as f64).sum();
+        if total <= 0.0 {
+            return 0.0;
+        }
+        power.sort_unstable_by(|a, b| b.total_cmp(a));
+        let k = ((fraction.clamp(0.0, 1.0) * power.len() as f32).ceil() as usize).max(1);
+        (power[..k].iter().map(|&p| p as f64).sum::<f64>() / total) as f32
+    }
+}
