@@ -248,6 +248,7 @@ fn build_material(bsdf: &BsdfDesc, span: &Span) -> Result<Material, BuildError> 
         BsdfDesc::Diffuse { albedo } => Material::Diffuse {
             albedo: build_texture(albedo, span, "albedo")?,
         },
+        BsdfDesc::OneSided(inner) => Material::OneSided(Box::new(build_material(inner, span)?)),
     })
 }
 

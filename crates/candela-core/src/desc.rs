@@ -92,6 +92,9 @@ pub struct MaterialDesc {
 pub enum BsdfDesc {
     /// Lambertian reflection with the given albedo.
     Diffuse { albedo: TextureDesc },
+    /// The inner BSDF on the front (the side the shading normal points to) and black
+    /// from the back, as Mitsuba's reflective BSDFs are unless wrapped in `twosided`.
+    OneSided(Box<BsdfDesc>),
 }
 
 /// A colour that may vary over a surface. Values are linear.

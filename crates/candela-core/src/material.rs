@@ -24,7 +24,11 @@ impl Texture {
 
 #[derive(Clone, Debug)]
 pub enum Material {
-    Diffuse { albedo: Texture },
+    Diffuse {
+        albedo: Texture,
+    },
+    /// Black from the back: see [`crate::desc::BsdfDesc::OneSided`].
+    OneSided(Box<Material>),
 }
 
 impl Material {
@@ -39,6 +43,34 @@ impl Material {
                     albedo: albedo.eval(uv),
                 }),
             ),
+            Material::OneSided(inner) => Bsdf {
+                one_sided: true,
+                ..inner.bsdf(ns, ng, uv)
+            },
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn one_sided_is_black_from_the_back_only() {
+        let diffuse = Material::Diffuse {
+            albedo: Texture::Constant(Vec3::splat(0.5)),
+        };
+        let two = diffuse.bsdf(Vec3::Z, Vec3::Z, Vec2::ZERO);
+        let one = Material::OneSided(Box::new(diffuse)).bsdf(Vec3::Z, Vec3::Z, Vec2::ZERO);
+        let (front, back) = (Vec3::new(0.3, 0.0, 0.9).normalize(), -Vec3::Z);
+        let wi = Vec3::new(-0.2, 0.1, 0.8).normalize();
+        assert_eq!(one.f(front, wi), two.f(front, wi));
+        assert_eq!(one.pdf(front, wi), two.pdf(front, wi));
+        assert!(one.sample(front, 0.5, Vec2::splat(0.3)).is_some());
+        // From the back the two-sided diffuse reflects; the one-sided one is black.
+        assert!(two.f(back, -wi).max_element() > 0.0);
+        assert_eq!(one.f(back, -wi), Vec3::ZERO);
+        assert_eq!(one.pdf(back, -wi), 0.0);
+        assert!(one.sample(back, 0.5, Vec2::splat(0.3)).is_none());
     }
 }
