@@ -323,9 +323,11 @@ impl Parser<'_> {
             let name = &after[..len];
             match self.params.get(name) {
                 Some(v) => out.push_str(v),
-                None => return Err(format!(
+                None => {
+                    return Err(format!(
                     "undefined parameter \"${name}\" (give it with -D {name}=VALUE or a <default>)"
-                )),
+                ))
+                }
             }
             rest = &after[len..];
         }
