@@ -31,7 +31,7 @@ fn step_matrix(s: &Node) -> Result<Mat4, LoadError> {
             if axis.length_squared() == 0.0 {
                 return Err(s.error("rotation axis is zero"));
             }
-            Mat4::from_axis_angle(axis.normalize(), angle.to_radians())
+            Mat4::from_mat3(rotation(axis, angle.to_radians()))
         }
         "matrix" => {
             let v = s.parse_list(s.req("value")?)?;
@@ -60,6 +60,20 @@ fn step_matrix(s: &Node) -> Result<Mat4, LoadError> {
             )))
         }
     })
+}
+
+/// Rodrigues' formula c·I + s·[k]× + (1 − c)·k·kᵀ exactly as Mitsuba evaluates it: with
+/// the axis as given, **not** normalized (so an axis of length ≠ 1 also scales and
+/// shears, and Candela puts the shape where Mitsuba does).
+fn rotation(k: Vec3, angle: f32) -> Mat3 {
+    let (s, c) = angle.sin_cos();
+    let cross = Mat3::from_cols(
+        Vec3::new(0.0, k.z, -k.y),
+        Vec3::new(-k.z, 0.0, k.x),
+        Vec3::new(k.y, -k.x, 0.0),
+    );
+    let outer = Mat3::from_cols(k * k.x, k * k.y, k * k.z);
+    Mat3::IDENTITY * c + cross * s + outer * (1.0 - c)
 }
 
 /// Mitsuba's `Transform4f::look_at`: the frame's +z looks at the target, +y is up and +x
