@@ -2,7 +2,8 @@
 //! here; errors carry the file, line and column they refer to.
 //!
 //! One module per format: [`toml_scene`] reads Candela's own scene format (see
-//! `docs/scene-format.md`), [`obj`] and [`ply`] read triangle meshes. A new scene format
+//! `docs/scene-format.md`), [`mitsuba`] a subset of Mitsuba 3's XML (see
+//! `docs/mitsuba.md`), [`obj`] and [`ply`] read triangle meshes. A new scene format
 //! plugs in as a module and one arm of the match in [`load_scene`].
 //!
 //! ```

@@ -1,5 +1,5 @@
 //! Mitsuba XML import, element by element: transforms and the camera against numbers
-//! computed once with Mitsuba 3.5 (`mitsuba` from PyPI, `scalar_rgb` variant; the
+//! computed once with Mitsuba 3.9.1 (`mitsuba` from PyPI, `scalar_rgb` variant; the
 //! scripts are quoted in each test), parameters, includes, references, BSDF sidedness,
 //! emitters, meshes, render settings.
 

@@ -98,7 +98,10 @@ fn materials_lights_and_primitives() {
         let m = desc.materials.iter().find(|m| m.name == name).unwrap();
         let BsdfDesc::Diffuse {
             albedo: TextureDesc::Constant(c),
-        } = m.bsdf;
+        } = m.bsdf
+        else {
+            panic!("{name} is not a constant diffuse: {:?}", m.bsdf)
+        };
         c
     };
     assert_eq!(albedo("grey"), Vec3::splat(0.25));

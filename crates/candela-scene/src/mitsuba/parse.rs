@@ -177,9 +177,9 @@ impl Node {
 
     /// Three numbers; with `splat`, one number stands for all three.
     pub fn parse_vec3(&self, v: &str, splat: bool) -> Result<Vec3, LoadError> {
-        match self.parse_list(v)?.as_slice() {
-            &[x] if splat => Ok(Vec3::splat(x)),
-            &[x, y, z] => Ok(Vec3::new(x, y, z)),
+        match *self.parse_list(v)?.as_slice() {
+            [x] if splat => Ok(Vec3::splat(x)),
+            [x, y, z] => Ok(Vec3::new(x, y, z)),
             _ => Err(self.error(format!("\"{v}\" must be three numbers"))),
         }
     }
