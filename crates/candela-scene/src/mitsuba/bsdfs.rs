@@ -83,7 +83,7 @@ fn bsdf(ctx: &mut Ctx, node: &Node) -> Result<BsdfDesc, LoadError> {
 fn two_sided(ctx: &mut Ctx, node: &Node) -> Result<BsdfDesc, LoadError> {
     let d = match node.kind() {
         "diffuse" => BsdfDesc::Diffuse {
-            albedo: TextureDesc::Constant(node.color("reflectance")?.unwrap_or(Vec3::splat(0.5))),
+            albedo: TextureDesc::Constant(ctx.color(node, "reflectance", Vec3::splat(0.5))?),
         },
         "twosided" => return Err(node.error("twosided inside twosided")),
         k => {

@@ -24,7 +24,7 @@ pub(crate) fn emitter(ctx: &mut Ctx, node: &Node) -> Result<(), LoadError> {
                 }
                 (p, t) => p.or(t).unwrap_or(Vec3::ZERO),
             };
-            let intensity = node.color("intensity")?.unwrap_or(Vec3::ONE);
+            let intensity = ctx.color(node, "intensity", Vec3::ONE)?;
             ctx.check_unused(node)?;
             ctx.desc.lights.push(LightDesc {
                 kind: LightKindDesc::Point {

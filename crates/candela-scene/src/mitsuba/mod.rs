@@ -16,6 +16,7 @@ use std::collections::HashMap;
 use std::path::Path;
 
 use candela_core::desc::SceneDesc;
+use glam::Vec3;
 
 use crate::{LoadError, LoadOptions, LoadedScene};
 use parse::Node;
@@ -99,6 +100,28 @@ impl Ctx {
             self.unsupported(c, format!("{what} is not supported in {}", describe(node)))?;
         }
         Ok(())
+    }
+
+    /// A colour property, or `default` when it is absent; a texture in its place (not
+    /// supported yet) is an error, or under `lenient` a warning and `default`.
+    pub fn color(&mut self, node: &Node, name: &str, default: Vec3) -> Result<Vec3, LoadError> {
+        match node
+            .children
+            .iter()
+            .find(|c| c.tag == "texture" && c.name() == name)
+        {
+            Some(t) => {
+                self.unsupported(
+                    t,
+                    format!(
+                        "<texture type=\"{}\"> as \"{name}\" is not supported yet",
+                        t.kind()
+                    ),
+                )?;
+                Ok(default)
+            }
+            None => Ok(node.color(name)?.unwrap_or(default)),
+        }
     }
 
     /// A unique material name for an unnamed BSDF.

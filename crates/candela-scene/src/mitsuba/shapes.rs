@@ -61,7 +61,7 @@ pub(crate) fn shape(ctx: &mut Ctx, node: &Node) -> Result<(), LoadError> {
         if emission.is_some() {
             return Err(e.error("a shape has at most one area emitter"));
         }
-        emission = Some(e.color("radiance")?.unwrap_or(Vec3::ONE));
+        emission = Some(ctx.color(e, "radiance", Vec3::ONE)?);
         ctx.check_unused(e)?;
     }
     ctx.check_unused(node)?;
