@@ -37,7 +37,7 @@ pub fn run(path: &Path, load: &LoadArgs) -> Result<(), UserError> {
         c.position.to_array(),
         c.look_at.to_array(),
         c.up.to_array(),
-        c.fov_y_deg
+        c.vertical_fov_deg()
     );
     println!(
         "bounds     {:?} to {:?}",

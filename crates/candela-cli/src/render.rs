@@ -9,7 +9,9 @@ use std::process::ExitCode;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
 
-use candela_core::desc::{LightSamplerKind, MisMode, SceneDesc};
+use candela_core::desc::{
+    ApertureSizeDesc, FocusDesc, LensDesc, LightSamplerKind, MisMode, SceneDesc,
+};
 use candela_core::integrator;
 use clap::{Args, ValueEnum};
 use indicatif::{ProgressBar, ProgressStyle};
@@ -83,6 +85,15 @@ pub struct RenderArgs {
     /// How next event estimation picks a light.
     #[arg(long, value_enum)]
     light_sampler: Option<LightSamplerArg>,
+    /// Focus distance of a thin lens, in scene units along the view axis (a pinhole
+    /// scene also needs --f-number to blur).
+    #[arg(long, allow_negative_numbers = true)]
+    focus_distance: Option<f32>,
+    /// f-number of a thin lens (aperture radius = focal length / 2N, scene units taken as
+    /// metres); turns a pinhole into a thin lens with a disc aperture, focused on look_at
+    /// unless --focus-distance says otherwise.
+    #[arg(long, allow_negative_numbers = true)]
+    f_number: Option<f32>,
 }
 
 #[derive(Clone, Copy, Debug, ValueEnum)]
@@ -132,6 +143,15 @@ impl RenderArgs {
                 LightSamplerArg::Uniform => LightSamplerKind::Uniform,
                 LightSamplerArg::Power => LightSamplerKind::Power,
             };
+        }
+        if self.focus_distance.is_some() || self.f_number.is_some() {
+            let lens = desc.camera.lens.get_or_insert_with(LensDesc::default);
+            if let Some(d) = self.focus_distance {
+                lens.focus = FocusDesc::Distance(d);
+            }
+            if let Some(n) = self.f_number {
+                lens.size = ApertureSizeDesc::FNumber(n);
+            }
         }
     }
 }
@@ -209,4 +229,38 @@ pub fn run(args: RenderArgs) -> Result<ExitCode, UserError> {
         return Ok(ExitCode::from(130));
     }
     Ok(ExitCode::SUCCESS)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use clap::Parser;
+
+    #[derive(Parser)]
+    struct Cli {
+        #[command(flatten)]
+        render: RenderArgs,
+    }
+
+    fn overridden(args: &[&str]) -> SceneDesc {
+        let cli = Cli::try_parse_from([&["candela", "s.toml", "-o", "x.png"], args].concat())
+            .expect("flags parse");
+        let mut desc = SceneDesc::default();
+        cli.render.apply_overrides(&mut desc);
+        desc
+    }
+
+    #[test]
+    fn lens_flags_turn_a_pinhole_into_a_thin_lens() {
+        assert!(overridden(&[]).camera.lens.is_none());
+        let lens = overridden(&["--f-number", "2.8"]).camera.lens.unwrap();
+        assert_eq!(lens.size, ApertureSizeDesc::FNumber(2.8));
+        assert_eq!(lens.focus, FocusDesc::LookAt);
+        let lens = overridden(&["--focus-distance", "3.5", "--f-number", "4"])
+            .camera
+            .lens
+            .unwrap();
+        assert_eq!(lens.focus, FocusDesc::Distance(3.5));
+        assert_eq!(lens.size, ApertureSizeDesc::FNumber(4.0));
+    }
 }

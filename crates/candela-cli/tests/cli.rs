@@ -228,3 +228,35 @@ fn interrupt_writes_the_partial_image() {
         .collect();
     assert!(floats.iter().any(|&v| v > 0.0) && floats.iter().all(|v| v.is_finite()));
 }
+
+#[test]
+fn lens_flags_blur_the_render_and_bad_values_are_located_errors() {
+    let (dir, scene) = scene_dir(SCENE);
+    let render = |name: &str, extra: &[&str]| {
+        let out = dir.path().join(name);
+        let args = [&["render", s(&scene), "-o", s(&out), "--spp", "4"], extra].concat();
+        let o = candela(&args);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        std::fs::read(&out).unwrap()
+    };
+    let pinhole = render("a.pfm", &[]);
+    // A very wide aperture focused far behind the sphere changes the image...
+    let blurred = render("b.pfm", &["--f-number", "0.05", "--focus-distance", "20"]);
+    assert_ne!(pinhole, blurred);
+    // ...a focus distance alone keeps the pinhole (no aperture), bit for bit.
+    assert_eq!(pinhole, render("c.pfm", &["--focus-distance", "20"]));
+
+    let o = candela(&[
+        "render",
+        s(&scene),
+        "-o",
+        s(&dir.path().join("d.png")),
+        "--f-number",
+        "-1",
+    ]);
+    assert_eq!(o.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&o.stderr);
+    let line = SCENE.lines().position(|l| l == "[camera]").unwrap() + 1;
+    assert!(err.contains(&format!("scene.toml:{line}:")), "{err}");
+    assert!(err.contains("f-number -1 must be positive"), "{err}");
+}

@@ -10,7 +10,8 @@ use glam::{Mat3, Mat4, Vec2, Vec3};
 use crate::bvh::Bvh;
 use crate::camera::Camera;
 use crate::desc::{
-    BsdfDesc, GeometryDesc, LightKindDesc, MeshDesc, SceneDesc, ShapeDesc, Span, TextureDesc,
+    ApertureDesc, ApertureSizeDesc, BsdfDesc, CameraDesc, FocusDesc, GeometryDesc, LensDesc,
+    LightKindDesc, MeshDesc, SceneDesc, ShapeDesc, Span, TextureDesc,
 };
 use crate::geometry::Aabb;
 use crate::light::{Light, LightId, PointLight, SphereLight, TriangleLight};
@@ -222,6 +223,17 @@ fn build_camera(desc: &SceneDesc) -> Result<Camera, BuildError> {
             "camera up vector is parallel to the view direction (or zero)",
         );
     }
+    if let Some(f) = c.focal_length_mm {
+        if !(f.is_finite() && f > 0.0) {
+            return err(&c.span, format!("focal length {f} mm must be positive"));
+        }
+    }
+    if !(c.sensor_mm.is_finite() && c.sensor_mm.min_element() > 0.0) {
+        return err(
+            &c.span,
+            format!("sensor size {} mm must be positive", c.sensor_mm),
+        );
+    }
     if !(c.fov_y_deg > 0.0 && c.fov_y_deg < 180.0) {
         return err(
             &c.span,
@@ -231,7 +243,77 @@ fn build_camera(desc: &SceneDesc) -> Result<Camera, BuildError> {
             ),
         );
     }
+    if let Some(lens) = &c.lens {
+        validate_lens(c, lens)?;
+    }
     Ok(Camera::new(c, desc.render.width, desc.render.height))
+}
+
+fn validate_lens(c: &CameraDesc, lens: &LensDesc) -> Result<(), BuildError> {
+    let forward = (c.look_at - c.position).normalize();
+    let focus = match lens.focus {
+        FocusDesc::LookAt => (c.look_at - c.position).length(),
+        FocusDesc::Distance(d) => d,
+        FocusDesc::Point(p) => {
+            check_finite(&c.span, "focus point", &p.to_array())?;
+            (p - c.position).dot(forward)
+        }
+    };
+    if !(focus.is_finite() && focus > 0.0) {
+        return err(
+            &c.span,
+            format!("focus distance {focus} must be positive (in front of the camera)"),
+        );
+    }
+    match lens.size {
+        ApertureSizeDesc::Radius(r) if !(r.is_finite() && r >= 0.0) => {
+            return err(&c.span, format!("aperture radius {r} must not be negative"));
+        }
+        ApertureSizeDesc::FNumber(n) if !(n.is_finite() && n > 0.0) => {
+            return err(&c.span, format!("f-number {n} must be positive"));
+        }
+        _ => {}
+    }
+    match &lens.aperture {
+        ApertureDesc::Disc => {}
+        ApertureDesc::Polygon {
+            blades,
+            rotation_deg,
+        } => {
+            if !(3..=64).contains(blades) {
+                return err(
+                    &c.span,
+                    format!("aperture blades {blades} must be between 3 and 64"),
+                );
+            }
+            check_finite(&c.span, "aperture rotation", &[*rotation_deg])?;
+        }
+        ApertureDesc::Image {
+            width,
+            height,
+            luminance,
+        } => {
+            if *width == 0 || *height == 0 {
+                return err(&c.span, "aperture image is empty");
+            }
+            if luminance.len() != *width as usize * *height as usize {
+                return err(
+                    &c.span,
+                    format!(
+                        "aperture image has {} values for {width}x{height} pixels",
+                        luminance.len()
+                    ),
+                );
+            }
+            if luminance.iter().any(|v| !v.is_finite() || *v < 0.0) {
+                return err(&c.span, "aperture image has a negative or non-finite value");
+            }
+            if !luminance.iter().any(|&v| v > 0.0) {
+                return err(&c.span, "aperture image is black: no light passes");
+            }
+        }
+    }
+    Ok(())
 }
 
 fn build_texture(t: &TextureDesc, span: &Span, what: &str) -> Result<Texture, BuildError> {

@@ -62,8 +62,15 @@ pub struct CameraDesc {
     pub position: Vec3,
     pub look_at: Vec3,
     pub up: Vec3,
-    /// Vertical field of view in degrees.
+    /// Vertical field of view in degrees; ignored when `focal_length_mm` is set.
     pub fov_y_deg: f32,
+    /// Focal length in millimetres: with `sensor_mm`, the alternative to `fov_y_deg`.
+    pub focal_length_mm: Option<f32>,
+    /// Sensor size in millimetres (width, height); its height spans the image's height.
+    /// Default 36×24 mm (full frame).
+    pub sensor_mm: Vec2,
+    /// A thin lens for depth of field; `None` is a pinhole.
+    pub lens: Option<LensDesc>,
     pub span: Span,
 }
 
@@ -74,9 +81,64 @@ impl Default for CameraDesc {
             look_at: Vec3::ZERO,
             up: Vec3::Y,
             fov_y_deg: 40.0,
+            focal_length_mm: None,
+            sensor_mm: Vec2::new(36.0, 24.0),
+            lens: None,
             span: Span::code(),
         }
     }
+}
+
+/// A thin lens: where it focuses, how wide it opens and the shape of its aperture.
+#[derive(Clone, Debug, Default)]
+pub struct LensDesc {
+    pub focus: FocusDesc,
+    pub size: ApertureSizeDesc,
+    pub aperture: ApertureDesc,
+}
+
+/// Where a thin lens focuses.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub enum FocusDesc {
+    /// On the camera's `look_at` point.
+    #[default]
+    LookAt,
+    /// At this distance along the view axis, in scene units.
+    Distance(f32),
+    /// On the plane through this point, perpendicular to the view axis.
+    Point(Vec3),
+}
+
+/// How wide a thin lens opens.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum ApertureSizeDesc {
+    /// Radius in scene units (the circumradius of a polygonal aperture).
+    Radius(f32),
+    /// f-number N: radius = focal length / (2N), with scene units taken as metres.
+    FNumber(f32),
+}
+
+impl Default for ApertureSizeDesc {
+    fn default() -> Self {
+        ApertureSizeDesc::Radius(0.0)
+    }
+}
+
+/// The shape of a thin lens's aperture.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub enum ApertureDesc {
+    #[default]
+    Disc,
+    /// A regular polygon of `blades` corners on the aperture circle; corner 0 points up
+    /// at rotation 0, and `rotation_deg` turns it counter-clockwise.
+    Polygon { blades: u32, rotation_deg: f32 },
+    /// An image mask: decoded linear luminance, `width`×`height`, row-major from the top
+    /// row. Fitted into the aperture circle's bounding square, longer side to diameter.
+    Image {
+        width: u32,
+        height: u32,
+        luminance: Vec<f32>,
+    },
 }
 
 /// A named material. Shapes refer to materials by name; the build resolves the names.

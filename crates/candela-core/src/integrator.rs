@@ -110,7 +110,13 @@ fn render_pixels<S: Sampler>(
         for index in pass.clone() {
             sampler.start_pixel_sample(p, index);
             let film_pos = p.as_vec2() + sampler.get_pixel_2d();
-            let ray = scene.camera.generate_ray(film_pos);
+            // A pinhole takes no lens dimensions, so its streams are as they were.
+            let lens_u = if scene.camera.needs_lens_sample() {
+                sampler.get_2d()
+            } else {
+                Vec2::splat(0.5)
+            };
+            let ray = scene.camera.generate_lens_ray(film_pos, lens_u);
             let l = li(scene, ray, sampler, &mut stats.rays);
             stats.paths += 1;
             pixel.add(l, 1.0);

@@ -2,9 +2,10 @@
 //! (seed, pixel, sample index) alone, so an image does not depend on the thread count or
 //! on the order in which tiles are rendered.
 //!
-//! Per bounce the integrator takes its dimensions in a fixed order: light pick (1D),
-//! light point (2D), BSDF lobe (1D), BSDF direction (2D), Russian roulette (1D). A
-//! low-discrepancy sampler can rely on that order.
+//! Each pixel sample starts with the position in the pixel (2D) and, for a camera with a
+//! thin lens only, the lens point (2D). Then, per bounce, the integrator takes its
+//! dimensions in a fixed order: light pick (1D), light point (2D), BSDF lobe (1D), BSDF
+//! direction (2D), Russian roulette (1D). A low-discrepancy sampler can rely on that order.
 
 use glam::{UVec2, Vec2};
 

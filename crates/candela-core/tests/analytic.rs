@@ -95,6 +95,7 @@ fn inside_camera(position: Vec3, look_at: Vec3) -> CameraDesc {
         up: Vec3::Y,
         fov_y_deg: 70.0,
         span: Span::code(),
+        ..Default::default()
     }
 }
 
@@ -227,6 +228,7 @@ fn plane_radiance(rho: f32, intensity: f32, h: f32, target: Vec3, mis: MisMode) 
             // A footprint ~10⁻³ wide: the radiance varies over it by ~10⁻⁶ relative.
             fov_y_deg: 0.02,
             span: Span::code(),
+            ..Default::default()
         },
         render: RenderSettings {
             width: 4,

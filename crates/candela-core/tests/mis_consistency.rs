@@ -56,6 +56,7 @@ fn cornell(mis: MisMode, light_scale: f32) -> SceneDesc {
             up: Vec3::Y,
             fov_y_deg: 39.3077,
             span: Span::code(),
+            ..Default::default()
         },
         render: RenderSettings {
             width: RES,

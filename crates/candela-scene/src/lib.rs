@@ -35,6 +35,7 @@ use candela_core::desc::{MeshDesc, SceneDesc, Span};
 
 pub mod obj;
 pub mod ply;
+mod toml_camera;
 pub mod toml_scene;
 mod toml_shape;
 mod toml_values;

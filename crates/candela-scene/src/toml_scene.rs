@@ -10,8 +10,8 @@
 use std::path::Path;
 
 use candela_core::desc::{
-    BsdfDesc, CameraDesc, LightDesc, LightKindDesc, LightSamplerKind, MaterialDesc, MisMode,
-    RenderSettings, SceneDesc, TextureDesc,
+    BsdfDesc, LightDesc, LightKindDesc, LightSamplerKind, MaterialDesc, MisMode, RenderSettings,
+    SceneDesc, TextureDesc,
 };
 use glam::Vec3;
 use serde::de::{DeserializeOwned, IgnoredAny};
@@ -19,8 +19,9 @@ use serde::Deserialize;
 use toml::de::{DeTable, DeValue, ValueDeserializer};
 use toml::Spanned;
 
+use crate::toml_camera::parse_camera;
 use crate::toml_shape::parse_shape;
-use crate::toml_values::{Num, Splat3, V3};
+use crate::toml_values::{Splat3, V3};
 use crate::{LoadError, Source};
 
 /// One item of the parsed tree: a value and its byte range in the text.
@@ -37,7 +38,7 @@ pub fn parse_toml_scene(text: &str, file: &Path) -> Result<SceneDesc, LoadError>
         let key_at = key.span().start;
         match key.get_ref().as_ref() {
             "render" => desc.render = parse_render(&src, value)?,
-            "camera" => desc.camera = parse_camera(&src, key_at, value)?,
+            "camera" => desc.camera = parse_camera(&src, base, key_at, value)?,
             "materials" => desc.materials = parse_materials(&src, value)?,
             "shape" => {
                 for item in array_of_tables(&src, "shape", value)? {
@@ -182,35 +183,6 @@ fn parse_render(src: &Source, value: Item) -> Result<RenderSettings, LoadError> 
         };
     }
     Ok(out)
-}
-
-#[derive(Deserialize)]
-#[serde(rename_all = "snake_case")]
-enum CameraType {
-    Pinhole,
-}
-
-#[derive(Deserialize)]
-#[serde(deny_unknown_fields)]
-struct CameraSection {
-    #[serde(rename = "type")]
-    _kind: Option<CameraType>,
-    position: Option<V3>,
-    look_at: Option<V3>,
-    up: Option<V3>,
-    fov: Option<Num>,
-}
-
-fn parse_camera(src: &Source, key_at: usize, value: Item) -> Result<CameraDesc, LoadError> {
-    let c: CameraSection = deserialize(src, value)?;
-    let d = CameraDesc::default();
-    Ok(CameraDesc {
-        position: c.position.map_or(d.position, V3::vec3),
-        look_at: c.look_at.map_or(d.look_at, V3::vec3),
-        up: c.up.map_or(d.up, V3::vec3),
-        fov_y_deg: c.fov.map_or(d.fov_y_deg, |n| n.0),
-        span: src.span(key_at),
-    })
 }
 
 #[derive(Deserialize)]

@@ -21,7 +21,7 @@ fn unknown_key() {
     assert_eq!(
         error(text),
         "scene.toml:6:1: unknown field `fvo`, expected one of `type`, `position`, `look_at`, \
-         `up`, `fov`"
+         `up`, `fov`, `focal_length`, `sensor`"
     );
 }
 
@@ -295,7 +295,7 @@ fn toml_syntax_error() {
 #[test]
 fn unknown_camera_type() {
     assert_eq!(
-        error("[camera]\ntype = \"thin_lens\"\n"),
-        "scene.toml:2:8: unknown variant `thin_lens`, expected `pinhole`"
+        error("[camera]\ntype = \"fisheye\"\n"),
+        "scene.toml:2:8: unknown camera type `fisheye`, expected one of `pinhole`, `thin_lens`"
     );
 }

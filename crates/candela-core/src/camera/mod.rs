@@ -1,0 +1,201 @@
+//! Cameras. In its own frame a camera sits at the origin and looks down −z, with +y up
+//! and +x to the right of the image. A camera is a pinhole, or a pinhole with a
+//! [`ThinLens`] for depth of field.
+
+mod aperture;
+mod thin_lens;
+
+pub use aperture::{Aperture, ImageAperture, PolygonAperture};
+pub use thin_lens::ThinLens;
+
+use glam::{Vec2, Vec3};
+
+use crate::desc::CameraDesc;
+use crate::geometry::Ray;
+
+impl CameraDesc {
+    /// The vertical field of view in degrees: from the focal length and the sensor height
+    /// when a focal length is given, else `fov_y_deg`.
+    pub fn vertical_fov_deg(&self) -> f32 {
+        match self.focal_length_mm {
+            Some(f) => (2.0 * (0.5 * self.sensor_mm.y / f).atan()).to_degrees(),
+            None => self.fov_y_deg,
+        }
+    }
+
+    /// The focal length in millimetres: as given, or the one that gives `fov_y_deg` on
+    /// the sensor (36×24 mm full frame by default, so 24 mm high).
+    pub fn focal_length_mm(&self) -> f32 {
+        match self.focal_length_mm {
+            Some(f) => f,
+            None => 0.5 * self.sensor_mm.y / (0.5 * self.fov_y_deg.to_radians()).tan(),
+        }
+    }
+}
+
+/// A perspective camera: a pinhole, or a thin lens when `lens` is set.
+#[derive(Clone, Debug)]
+pub struct Camera {
+    pub position: Vec3,
+    /// Camera-to-world rotation: columns are the camera's right, up and backward axes.
+    right: Vec3,
+    up: Vec3,
+    back: Vec3,
+    /// tan(fov_y / 2)
+    tan_half_fov: f32,
+    resolution: Vec2,
+    lens: Option<ThinLens>,
+}
+
+impl Camera {
+    /// A camera for a film of `width`×`height` pixels. The description must have been
+    /// validated (distinct position and target, up not parallel to the view, a lens with
+    /// positive focus distance and a usable aperture). A lens of radius 0 is a pinhole.
+    pub fn new(desc: &CameraDesc, width: u32, height: u32) -> Camera {
+        let back = (desc.position - desc.look_at).normalize();
+        let right = desc.up.cross(back).normalize();
+        let up = back.cross(right);
+        let lens = desc
+            .lens
+            .as_ref()
+            .map(|l| ThinLens::new(desc, l))
+            .filter(|l| l.aperture_radius > 0.0);
+        Camera {
+            position: desc.position,
+            right,
+            up,
+            back,
+            tan_half_fov: (desc.vertical_fov_deg().to_radians() * 0.5).tan(),
+            resolution: Vec2::new(width as f32, height as f32),
+            lens,
+        }
+    }
+
+    /// The thin lens, if the camera has one.
+    pub fn lens(&self) -> Option<&ThinLens> {
+        self.lens.as_ref()
+    }
+
+    /// Whether [`Self::generate_lens_ray`] uses its lens sample; a pinhole does not, so
+    /// the integrator takes no lens dimensions for it.
+    pub fn needs_lens_sample(&self) -> bool {
+        self.lens.is_some()
+    }
+
+    /// Direction (camera frame, z = −1) of the pinhole ray through film position `film`.
+    fn pinhole_direction(&self, film: Vec2) -> Vec3 {
+        let ndc = film / self.resolution;
+        let aspect = self.resolution.x / self.resolution.y;
+        let x = (2.0 * ndc.x - 1.0) * self.tan_half_fov * aspect;
+        let y = (1.0 - 2.0 * ndc.y) * self.tan_half_fov;
+        Vec3::new(x, y, -1.0)
+    }
+
+    fn to_world(&self, v: Vec3) -> Vec3 {
+        self.right * v.x + self.up * v.y + self.back * v.z
+    }
+
+    /// The ray through film position `film` (in pixels, (0,0) at the top left) from the
+    /// centre of the lens: the pinhole ray.
+    pub fn generate_ray(&self, film: Vec2) -> Ray {
+        let d = self.to_world(self.pinhole_direction(film)).normalize();
+        Ray::new(self.position, d)
+    }
+
+    /// The ray through film position `film` from the lens point of the uniform sample
+    /// `lens_u`; a pinhole ignores `lens_u`.
+    pub fn generate_lens_ray(&self, film: Vec2, lens_u: Vec2) -> Ray {
+        let Some(lens) = &self.lens else {
+            return self.generate_ray(film);
+        };
+        let (o, d) = lens.ray(self.pinhole_direction(film), lens_u);
+        Ray::new(
+            self.position + self.to_world(o),
+            self.to_world(d).normalize(),
+        )
+    }
+
+    /// The film position (pixels) whose ray from lens sample `lens_u` passes through the
+    /// world point `p`; `None` when `p` is not in front of the lens. The inverse of
+    /// [`Self::generate_lens_ray`], for tests and for tracing from lights.
+    pub fn project(&self, p: Vec3, lens_u: Vec2) -> Option<Vec2> {
+        let v = p - self.position;
+        let pc = Vec3::new(v.dot(self.right), v.dot(self.up), v.dot(self.back));
+        let on_focus = match &self.lens {
+            Some(lens) => lens.focus_point(pc, lens.sample_point(lens_u))?,
+            None if pc.z < 0.0 => pc / -pc.z,
+            None => return None,
+        };
+        let (x, y) = (on_focus.x / -on_focus.z, on_focus.y / -on_focus.z);
+        let aspect = self.resolution.x / self.resolution.y;
+        let ndc = Vec2::new(
+            0.5 * (x / (self.tan_half_fov * aspect) + 1.0),
+            0.5 * (1.0 - y / self.tan_half_fov),
+        );
+        Some(ndc * self.resolution)
+    }
+
+    /// The camera's viewing direction in world space.
+    pub fn forward(&self) -> Vec3 {
+        -self.back
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::desc::{ApertureSizeDesc, FocusDesc, LensDesc};
+
+    #[test]
+    fn centre_ray_looks_at_target_and_corners_span_the_fov() {
+        let desc = CameraDesc {
+            position: Vec3::new(0.0, 1.0, 5.0),
+            look_at: Vec3::new(0.0, 1.0, 0.0),
+            up: Vec3::Y,
+            fov_y_deg: 90.0,
+            ..Default::default()
+        };
+        let cam = Camera::new(&desc, 200, 100);
+        let c = cam.generate_ray(Vec2::new(100.0, 50.0));
+        assert!((c.d - Vec3::new(0.0, 0.0, -1.0)).length() < 1e-6);
+        // Top edge centre is 45° up; right edge centre is atan(2) to the right (aspect 2).
+        let top = cam.generate_ray(Vec2::new(100.0, 0.0));
+        assert!((top.d.y - std::f32::consts::FRAC_1_SQRT_2).abs() < 1e-5);
+        let right = cam.generate_ray(Vec2::new(200.0, 50.0));
+        assert!(right.d.x > 0.0 && (right.d.x / -right.d.z - 2.0).abs() < 1e-5);
+    }
+
+    #[test]
+    fn focal_length_and_fov_agree_on_a_full_frame_sensor() {
+        // A 50 mm lens on a 24 mm high sensor: fov = 2·atan(12/50) = 26.99°.
+        let desc = CameraDesc {
+            focal_length_mm: Some(50.0),
+            ..Default::default()
+        };
+        assert!((desc.vertical_fov_deg() - 26.9915).abs() < 1e-3);
+        let back = CameraDesc {
+            fov_y_deg: desc.vertical_fov_deg(),
+            ..Default::default()
+        };
+        assert!((back.focal_length_mm() - 50.0).abs() < 1e-3);
+    }
+
+    #[test]
+    fn f_number_sets_radius_and_focus_point_sets_distance() {
+        let desc = CameraDesc {
+            position: Vec3::ZERO,
+            look_at: Vec3::new(0.0, 0.0, -1.0),
+            focal_length_mm: Some(50.0),
+            lens: Some(LensDesc {
+                focus: FocusDesc::Point(Vec3::new(3.0, 1.0, -4.0)),
+                size: ApertureSizeDesc::FNumber(2.0),
+                ..Default::default()
+            }),
+            ..Default::default()
+        };
+        let cam = Camera::new(&desc, 64, 64);
+        let lens = cam.lens().unwrap();
+        assert!((lens.aperture_radius - 0.0125).abs() < 1e-7); // 50 mm / (2·2) in metres
+        assert!((lens.focus_distance - 4.0).abs() < 1e-6); // along the view axis only
+    }
+}
