@@ -431,3 +431,48 @@ fn one_sided_diffuse_is_black_from_behind_as_in_mitsuba() {
     let back = render(-5.0, true);
     assert!((back / mitsuba - 1.0).abs() < 0.005, "{back}");
 }
+
+#[test]
+fn thin_lens_rays_focus_where_mitsuba_focuses() {
+    // Every Mitsuba ray through film uv (0.75, 0.25) of this thinlens sensor, whatever
+    // its aperture sample, crosses the focus plane (4 along the view axis) at the same
+    // point:
+    //   s = mi.load_dict({'type': 'thinlens', 'fov': 50.0, 'aperture_radius': 0.2,
+    //     'focus_distance': 4.0, 'to_world': ...look_at([1,2,3], [0,0,0], [0,1,0]),
+    //     'film': {'type': 'hdrfilm', 'width': 200, 'height': 100}})
+    //   r = s.sample_ray(0, 0.5, [0.75, 0.25], ap)[0]  -> r.o + r.d·t on the plane
+    let focus = Vec3::new(0.736891, 0.256012, -0.738515);
+    let desc = load(&scene(
+        r#"<sensor type="thinlens"><float name="fov" value="50"/>
+             <float name="aperture_radius" value="0.2"/><float name="focus_distance" value="4"/>
+             <transform name="to_world"><lookat origin="1,2,3" target="0,0,0" up="0,1,0"/></transform>
+             <film type="hdrfilm"><integer name="width" value="200"/><integer name="height" value="100"/></film>
+           </sensor>"#,
+    ));
+    let cam = Camera::new(&desc.camera, 200, 100);
+    let (eye, fwd) = (
+        Vec3::new(1.0, 2.0, 3.0),
+        -Vec3::new(1.0, 2.0, 3.0).normalize(),
+    );
+    let mut spread = 0.0f32;
+    for u in [
+        Vec2::new(0.5, 0.5),
+        Vec2::new(0.1, 0.9),
+        Vec2::new(0.8, 0.3),
+        Vec2::new(0.95, 0.05),
+    ] {
+        let ray = cam.generate_lens_ray(Vec2::new(150.0, 25.0), u);
+        assert!((ray.o - eye).length() <= 0.2 + 1e-5);
+        spread = spread.max((ray.o - eye).length());
+        let t = (4.0 - (ray.o - eye).dot(fwd)) / ray.d.dot(fwd);
+        assert_close(ray.o + ray.d * t, focus, 2e-4);
+    }
+    assert!(spread > 0.1, "the aperture is open");
+    let e = load_err(&scene(
+        r#"<sensor type="thinlens"><float name="fov" value="50"/></sensor>"#,
+    ));
+    assert!(
+        e.contains("scene.xml:2:1:") && e.contains("aperture_radius"),
+        "{e}"
+    );
+}

@@ -1,7 +1,7 @@
 //! `<sensor>` (with its `<film>` and `<sampler>`) and `<integrator>`: the camera and the
 //! render settings.
 
-use candela_core::desc::CameraDesc;
+use candela_core::desc::{ApertureDesc, ApertureSizeDesc, CameraDesc, FocusDesc, LensDesc};
 use glam::{Mat4, Vec3};
 
 use super::parse::Node;
@@ -60,14 +60,7 @@ pub(crate) fn integrator(ctx: &mut Ctx, node: &Node) -> Result<(), LoadError> {
 
 pub(crate) fn sensor(ctx: &mut Ctx, node: &Node) -> Result<(), LoadError> {
     match node.kind() {
-        "perspective" => {}
-        "thinlens" => {
-            ctx.unsupported(
-                node,
-                "<sensor type=\"thinlens\"> is not supported yet".into(),
-            )?;
-            ctx.warn(node, "rendering it as a pinhole camera");
-        }
+        "perspective" | "thinlens" => {}
         _ => return ctx.unsupported(node, format!("<{}> is not supported", describe(node))),
     }
     for f in node.plugins("film") {
@@ -98,6 +91,9 @@ pub(crate) fn sensor(ctx: &mut Ctx, node: &Node) -> Result<(), LoadError> {
         node.float(clip)?;
     }
     ctx.desc.camera = camera(ctx, node, to_world, fov_y_deg)?;
+    if node.kind() == "thinlens" {
+        ctx.desc.camera.lens = Some(thin_lens(node)?);
+    }
     ctx.check_unused(node)
 }
 
@@ -125,6 +121,25 @@ fn camera(ctx: &mut Ctx, node: &Node, m: Mat4, fov_y_deg: f32) -> Result<CameraD
         up,
         fov_y_deg,
         span: node.span.clone(),
+        ..CameraDesc::default()
+    })
+}
+
+/// Mitsuba's `thinlens`: a disc aperture of `aperture_radius` (scene units) focused on the
+/// plane `focus_distance` along the view axis, as Candela's thin lens.
+fn thin_lens(node: &Node) -> Result<LensDesc, LoadError> {
+    let get = |name: &str| {
+        node.float(name)?
+            .ok_or_else(|| node.error(format!("thinlens needs \"{name}\"")))
+    };
+    let (radius, focus) = (get("aperture_radius")?, get("focus_distance")?);
+    if radius < 0.0 || focus <= 0.0 {
+        return Err(node.error("thinlens needs aperture_radius >= 0 and focus_distance > 0"));
+    }
+    Ok(LensDesc {
+        focus: FocusDesc::Distance(focus),
+        size: ApertureSizeDesc::Radius(radius),
+        aperture: ApertureDesc::Disc,
     })
 }
 
