@@ -85,6 +85,9 @@ pub struct RenderArgs {
     /// How next event estimation picks a light.
     #[arg(long, value_enum)]
     light_sampler: Option<LightSamplerArg>,
+    /// Candidates per pick of the `ris` and `ris-bvh` light samplers.
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..))]
+    ris_candidates: Option<u32>,
     /// Focus distance of a thin lens, in scene units along the view axis (a pinhole
     /// scene also needs --f-number to blur).
     #[arg(long, allow_negative_numbers = true)]
@@ -100,6 +103,10 @@ pub struct RenderArgs {
 pub enum LightSamplerArg {
     Uniform,
     Power,
+    Array,
+    Ris,
+    Bvh,
+    RisBvh,
 }
 
 fn parse_resolution(s: &str) -> Result<(u32, u32), String> {
@@ -142,7 +149,14 @@ impl RenderArgs {
             r.light_sampler = match l {
                 LightSamplerArg::Uniform => LightSamplerKind::Uniform,
                 LightSamplerArg::Power => LightSamplerKind::Power,
+                LightSamplerArg::Array => LightSamplerKind::Array,
+                LightSamplerArg::Ris => LightSamplerKind::Ris,
+                LightSamplerArg::Bvh => LightSamplerKind::Bvh,
+                LightSamplerArg::RisBvh => LightSamplerKind::RisBvh,
             };
+        }
+        if let Some(n) = self.ris_candidates {
+            r.ris_candidates = n;
         }
         if self.focus_distance.is_some() || self.f_number.is_some() {
             let lens = desc.camera.lens.get_or_insert_with(LensDesc::default);

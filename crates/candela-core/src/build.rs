@@ -179,7 +179,7 @@ pub fn build(desc: &SceneDesc) -> Result<Scene, BuildError> {
         });
     }
     let bvh = Bvh::build(&boxes);
-    let light_sampler = LightSampler::new(r.light_sampler, &lights);
+    let light_sampler = LightSampler::new(r.light_sampler, r.ris_candidates, &lights);
     let infinite_lights = lights
         .iter()
         .enumerate()

@@ -243,7 +243,18 @@ pub enum LightSamplerKind {
     /// Proportional to emitted power, through an alias table.
     #[default]
     Power,
+    /// Proportional to power through the course notes' slot array.
+    Array,
+    /// Resampled importance sampling over candidates from the array.
+    Ris,
+    /// Light BVH with orientation cones (Conty Estevez & Kulla 2018).
+    Bvh,
+    /// Resampled importance sampling over candidates from the light BVH.
+    RisBvh,
 }
+
+/// Default number of RIS candidates, chosen by `bench/many_lights`.
+pub const DEFAULT_RIS_CANDIDATES: u32 = 2;
 
 /// Render settings a scene carries; the command line may override them.
 #[derive(Clone, Debug)]
@@ -257,6 +268,8 @@ pub struct RenderSettings {
     pub seed: u64,
     pub mis: MisMode,
     pub light_sampler: LightSamplerKind,
+    /// Candidates per pick of the RIS light samplers.
+    pub ris_candidates: u32,
 }
 
 impl Default for RenderSettings {
@@ -269,6 +282,7 @@ impl Default for RenderSettings {
             seed: 0,
             mis: MisMode::default(),
             light_sampler: LightSamplerKind::default(),
+            ris_candidates: DEFAULT_RIS_CANDIDATES,
         }
     }
 }

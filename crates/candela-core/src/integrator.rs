@@ -233,9 +233,10 @@ fn sample_direct(
     rays: &mut u64,
 ) -> Vec3 {
     let mode = scene.settings.mis;
-    let Some((id, pmf)) = scene.light_sampler.sample(ctx, u_light) else {
+    let Some(pick) = scene.light_sampler.sample(ctx, u_light, &scene.lights) else {
         return Vec3::ZERO;
     };
+    let id = pick.id;
     let light = scene.light(id);
     // BSDF-only estimation still needs NEE for delta lights, which no ray can hit.
     if mode == MisMode::BsdfOnly && !light.is_delta() {
@@ -257,11 +258,14 @@ fn sample_direct(
     if !visible {
         return Vec3::ZERO;
     }
-    let light_pdf = pmf * ls.pdf;
+    // For RIS, `pick.pmf` is 1/W (the unbiased RIS weight) and `pick.mis_pmf` a tractable
+    // surrogate of the pick probability; `emitter_weight` uses the same surrogate
+    // (`LightSampler::pmf`), so the NEE and BSDF weights of any (light, direction) still
+    // sum to one (see `light_sampler::ris`). For the other samplers the two are equal.
     let weight = match mode {
         _ if ls.is_delta => 1.0,
         MisMode::NeeOnly => 1.0,
-        _ => mis_weight(mode, light_pdf, bsdf.pdf(wo, ls.wi)),
+        _ => mis_weight(mode, pick.mis_pmf * ls.pdf, bsdf.pdf(wo, ls.wi)),
     };
-    f * ls.radiance * weight / light_pdf
+    f * ls.radiance * weight / (pick.pmf * ls.pdf)
 }

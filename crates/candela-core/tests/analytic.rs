@@ -53,6 +53,7 @@ fn settings(mis: MisMode, max_depth: u32, spp: u32, seed: u64) -> RenderSettings
         seed,
         mis,
         light_sampler: LightSamplerKind::Power,
+        ..Default::default()
     }
 }
 

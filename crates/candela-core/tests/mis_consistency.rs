@@ -66,6 +66,7 @@ fn cornell(mis: MisMode, light_scale: f32) -> SceneDesc {
             seed: 0,
             mis,
             light_sampler: LightSamplerKind::Power,
+            ..Default::default()
         },
         ..Default::default()
     };

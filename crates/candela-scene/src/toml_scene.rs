@@ -142,10 +142,14 @@ enum MisName {
 }
 
 #[derive(Deserialize)]
-#[serde(rename_all = "snake_case")]
+#[serde(rename_all = "kebab-case")]
 enum LightSamplerName {
     Uniform,
     Power,
+    Array,
+    Ris,
+    Bvh,
+    RisBvh,
 }
 
 #[derive(Deserialize)]
@@ -157,6 +161,7 @@ struct RenderSection {
     seed: Option<u64>,
     mis: Option<MisName>,
     light_sampler: Option<LightSamplerName>,
+    ris_candidates: Option<std::num::NonZeroU32>,
 }
 
 fn parse_render(src: &Source, value: Item) -> Result<RenderSettings, LoadError> {
@@ -180,7 +185,14 @@ fn parse_render(src: &Source, value: Item) -> Result<RenderSettings, LoadError> 
         out.light_sampler = match ls {
             LightSamplerName::Uniform => LightSamplerKind::Uniform,
             LightSamplerName::Power => LightSamplerKind::Power,
+            LightSamplerName::Array => LightSamplerKind::Array,
+            LightSamplerName::Ris => LightSamplerKind::Ris,
+            LightSamplerName::Bvh => LightSamplerKind::Bvh,
+            LightSamplerName::RisBvh => LightSamplerKind::RisBvh,
         };
+    }
+    if let Some(n) = r.ris_candidates {
+        out.ris_candidates = n.get();
     }
     Ok(out)
 }

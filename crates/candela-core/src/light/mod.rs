@@ -10,10 +10,12 @@
 //! All densities are in solid angle at the shading point. Delta lights (points) report
 //! `pdf = 1` and `is_delta`, and are never hit by rays.
 
+mod bounds;
 mod point;
 mod sphere;
 mod triangle;
 
+pub use bounds::{cone_measure, cone_union, ImportanceBounds, LightBounds};
 pub use point::PointLight;
 pub use sphere::SphereLight;
 pub use triangle::TriangleLight;
@@ -32,6 +34,15 @@ pub struct LightId(pub u32);
 pub struct ShadingCtx {
     pub p: Vec3,
     pub n: Vec3,
+}
+
+/// |n·ω| for a unit direction ω, or 1 where there is no normal.
+fn receiver_cos(ctx: &ShadingCtx, w: Vec3) -> f32 {
+    if ctx.n == Vec3::ZERO {
+        1.0
+    } else {
+        ctx.n.dot(w).abs()
+    }
 }
 
 /// A sampled direction towards a light.
@@ -99,6 +110,29 @@ impl Light {
             Light::Point(l) => l.power(),
             Light::Triangle(l) => l.power(),
             Light::Sphere(l) => l.power(),
+        }
+    }
+
+    /// Potential contribution at `ctx` up to a common constant, for choosing among lights
+    /// (the RIS target): solid angle × brightness × the largest receiver cosine |n·ω|,
+    /// or intensity ÷ d² for points. It is 0 only where the light provably sends nothing
+    /// that a BSDF could scatter, e.g. a point behind a one-sided emitter; the receiver
+    /// cosine is taken in absolute value so that transmitting BSDFs are not cut off.
+    pub fn importance(&self, ctx: &ShadingCtx) -> f32 {
+        match self {
+            Light::Point(l) => l.importance(ctx),
+            Light::Triangle(l) => l.importance(ctx),
+            Light::Sphere(l) => l.importance(ctx),
+        }
+    }
+
+    /// Bounds for the light BVH; `None` for lights that are not bounded in space (infinite
+    /// lights), which the BVH sampler picks apart from the tree.
+    pub fn bounds(&self) -> Option<LightBounds> {
+        match self {
+            Light::Point(l) => Some(l.bounds()),
+            Light::Triangle(l) => Some(l.bounds()),
+            Light::Sphere(l) => Some(l.bounds()),
         }
     }
 

@@ -2,7 +2,8 @@ use std::f32::consts::PI;
 
 use glam::Vec3;
 
-use super::{LightSample, ShadingCtx};
+use super::{receiver_cos, LightBounds, LightSample, ShadingCtx};
+use crate::geometry::Aabb;
 use crate::math::luminance;
 
 /// An isotropic point light: radiant intensity `intensity` (W/sr) in every direction.
@@ -33,5 +34,27 @@ impl PointLight {
 
     pub fn power(&self) -> f32 {
         4.0 * PI * luminance(self.intensity)
+    }
+
+    /// I/d² × |cos θ| at the receiver.
+    pub fn importance(&self, ctx: &ShadingCtx) -> f32 {
+        let to = self.position - ctx.p;
+        let d2 = to.length_squared();
+        if d2 == 0.0 {
+            return 0.0;
+        }
+        luminance(self.intensity) / d2 * receiver_cos(ctx, to / d2.sqrt())
+    }
+
+    /// A point emitting into every direction.
+    pub fn bounds(&self) -> LightBounds {
+        LightBounds {
+            aabb: Aabb::from_points(&[self.position]),
+            w: Vec3::Z,
+            intensity: luminance(self.intensity),
+            cos_theta_o: -1.0,
+            cos_theta_e: 0.0,
+            two_sided: false,
+        }
     }
 }

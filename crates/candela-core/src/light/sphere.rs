@@ -2,7 +2,8 @@ use std::f32::consts::PI;
 
 use glam::{Vec2, Vec3};
 
-use super::{LightSample, ShadingCtx};
+use super::{LightBounds, LightSample, ShadingCtx};
+use crate::geometry::Aabb;
 use crate::geometry::{intersect_sphere, Ray};
 use crate::math::{luminance, Frame};
 use crate::sampling::{sample_uniform_cone, sample_uniform_sphere, uniform_cone_pdf};
@@ -110,5 +111,42 @@ impl SphereLight {
 
     pub fn power(&self) -> f32 {
         PI * self.area() * luminance(self.le)
+    }
+
+    /// Seen from outside: L × the subtended solid angle 2π(1 − cos θ_max) × the largest
+    /// |cos| at the receiver over that cone. Inside (or emitting inwards): L × 4π.
+    pub fn importance(&self, ctx: &ShadingCtx) -> f32 {
+        let lum = luminance(self.le);
+        let Some(cos_max) = self.sees_outside(ctx.p) else {
+            return lum * 4.0 * PI;
+        };
+        let omega = 2.0 * PI * (1.0 - cos_max);
+        let cos_r = if ctx.n == Vec3::ZERO {
+            1.0
+        } else {
+            // Angle from the axis to the nearer of ±n, reduced by the cone's half-angle.
+            let axis = (self.center - ctx.p).normalize();
+            let theta = axis.dot(ctx.n).abs().min(1.0).acos();
+            let theta_max = cos_max.min(1.0).acos();
+            // 90° − θ is the angle to the tangent plane; |cos| is largest nearest ±n.
+            (theta - theta_max).max(0.0).cos()
+        };
+        lum * omega.max(1e-12) * cos_r.max(1e-6)
+    }
+
+    /// Normals in every direction; peak intensity L·πr² (the projected disk).
+    pub fn bounds(&self) -> LightBounds {
+        let r = Vec3::splat(self.radius);
+        LightBounds {
+            aabb: Aabb {
+                min: self.center - r,
+                max: self.center + r,
+            },
+            w: Vec3::Z,
+            intensity: luminance(self.le) * PI * self.radius * self.radius,
+            cos_theta_o: -1.0,
+            cos_theta_e: 0.0,
+            two_sided: false,
+        }
     }
 }

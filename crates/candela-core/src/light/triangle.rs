@@ -2,7 +2,8 @@ use std::f32::consts::PI;
 
 use glam::{Vec2, Vec3};
 
-use super::{LightSample, ShadingCtx};
+use super::{receiver_cos, LightBounds, LightSample, ShadingCtx};
+use crate::geometry::Aabb;
 use crate::geometry::{Ray, WatertightRay};
 use crate::math::luminance;
 use crate::sampling::sample_uniform_triangle;
@@ -73,5 +74,40 @@ impl TriangleLight {
     /// Φ = π · A · L for a one-sided Lambertian emitter.
     pub fn power(&self) -> f32 {
         PI * self.area * luminance(self.le)
+    }
+
+    /// L × Ω × the largest |cos| at the receiver over the three corners, where Ω is the
+    /// exact solid angle of the triangle (Van Oosterom & Strackee 1983):
+    /// tan(Ω/2) = |a·(b×c)| / (abc + (a·b)c + (a·c)b + (b·c)a).
+    /// Zero where the point lies behind the emitting side: the plane through the triangle
+    /// separates the point from the whole emitting hemisphere, so nothing reaches it.
+    pub fn importance(&self, ctx: &ShadingCtx) -> f32 {
+        if (ctx.p - self.p[0]).dot(self.n) <= 0.0 || self.area == 0.0 {
+            return 0.0;
+        }
+        let [a, b, c] = self.p.map(|q| q - ctx.p);
+        let (la, lb, lc) = (a.length(), b.length(), c.length());
+        let num = a.dot(b.cross(c)).abs();
+        let den = la * lb * lc + a.dot(b) * lc + a.dot(c) * lb + b.dot(c) * la;
+        let omega = 2.0 * num.atan2(den);
+        let cos_r = [a / la, b / lb, c / lc]
+            .iter()
+            .map(|w| receiver_cos(ctx, *w))
+            .fold(0.0f32, f32::max);
+        // A tiny floor keeps grazing but still visible triangles selectable.
+        luminance(self.le) * omega.max(1e-12) * cos_r
+    }
+
+    /// One-sided Lambertian emitter: normal cone of zero width, emission up to 90°;
+    /// peak intensity L·A along the normal.
+    pub fn bounds(&self) -> LightBounds {
+        LightBounds {
+            aabb: Aabb::from_points(&self.p),
+            w: self.n,
+            intensity: luminance(self.le) * self.area,
+            cos_theta_o: 1.0,
+            cos_theta_e: 0.0,
+            two_sided: false,
+        }
     }
 }
