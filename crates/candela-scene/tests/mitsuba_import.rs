@@ -476,3 +476,18 @@ fn thin_lens_rays_focus_where_mitsuba_focuses() {
         "{e}"
     );
 }
+
+#[test]
+fn the_example_scene_loads_cleanly_and_builds() {
+    let path = Path::new(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../scenes/mitsuba-cornell.xml"
+    ));
+    let loaded = load_scene_with(path, &LoadOptions::default()).unwrap();
+    assert!(loaded.warnings.is_empty(), "{:?}", loaded.warnings);
+    assert_eq!(loaded.desc.shapes.len(), 8);
+    let scene = candela_core::build::build(&loaded.desc).unwrap();
+    let b = scene.bounds();
+    assert_close(b.min, Vec3::new(-1.0, 0.0, -1.0), 1e-5);
+    assert_close(b.max, Vec3::new(1.0, 2.0, 1.0), 1e-5);
+}
