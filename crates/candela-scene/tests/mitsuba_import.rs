@@ -254,6 +254,17 @@ fn includes_and_references_resolve() {
         false,
     );
     assert!(r.unwrap_err().message.contains("nest too deep"));
+    // An error inside an included file points into that file.
+    let (_d, r) = load_files(
+        &[
+            ("scene.xml", &scene("<include filename=\"bad.xml\"/>")),
+            ("bad.xml", &scene("<shape type=\"torus\"/>")),
+        ],
+        &[],
+        false,
+    );
+    let e = r.unwrap_err().to_string();
+    assert!(e.contains("bad.xml:2:1:") && e.contains("torus"), "{e}");
 }
 
 #[test]
