@@ -205,11 +205,8 @@ pub(crate) fn is_property(tag: &str) -> bool {
 /// Parses a scene file (and what it includes) into its `<scene>` node. `defines` are the
 /// `-D name=value` parameters, which take precedence over `<default>`s.
 pub(crate) fn parse_file(path: &Path, defines: &[(String, String)]) -> Result<Node, LoadError> {
-    let mut params: HashMap<String, String> = defines.iter().cloned().collect();
-    let fixed: Vec<String> = defines.iter().map(|(k, _)| k.clone()).collect();
     let mut p = Parser {
-        params: &mut params,
-        fixed: &fixed,
+        params: defines.iter().cloned().collect(),
     };
     let span = Span::new(path.display().to_string(), 1, 1);
     let text = std::fs::read_to_string(path)
@@ -217,13 +214,12 @@ pub(crate) fn parse_file(path: &Path, defines: &[(String, String)]) -> Result<No
     p.parse_text(path, &text, 0)
 }
 
-struct Parser<'p> {
-    params: &'p mut HashMap<String, String>,
-    /// Names given on the command line: `<default>` does not override them.
-    fixed: &'p [String],
+struct Parser {
+    /// `-D` parameters, then the `<default>`s met so far.
+    params: HashMap<String, String>,
 }
 
-impl Parser<'_> {
+impl Parser {
     fn parse_text(&mut self, path: &Path, text: &str, depth: usize) -> Result<Node, LoadError> {
         let src = Source::new(path, text);
         let doc = roxmltree::Document::parse(text).map_err(|e| {
@@ -258,9 +254,10 @@ impl Parser<'_> {
             let (Some(name), Some(value)) = (d.attribute("name"), d.attribute("value")) else {
                 return Err(src.error(at, "<default> needs \"name\" and \"value\""));
             };
-            if !self.fixed.iter().any(|f| f == name) {
-                self.params.insert(name.to_string(), value.to_string());
-            }
+            // A default only fills a parameter nobody has set (-D, or an earlier file).
+            self.params
+                .entry(name.to_string())
+                .or_insert_with(|| value.to_string());
         }
         let mut scene = self.convert(&src, root)?;
         let mut children = Vec::new();
