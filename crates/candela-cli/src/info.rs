@@ -4,10 +4,11 @@ use std::path::Path;
 
 use candela_core::light::{EnvironmentLight, EnvironmentMap, Light};
 
+use crate::render::LoadArgs;
 use crate::UserError;
 
-pub fn run(path: &Path) -> Result<(), UserError> {
-    let desc = candela_scene::load_scene(path)?;
+pub fn run(path: &Path, load: &LoadArgs) -> Result<(), UserError> {
+    let desc = load.load(path)?;
     let scene = candela_core::build::build(&desc)?;
     let s = &scene.settings;
     let b = scene.bounds();

@@ -28,8 +28,10 @@ enum Command {
     Render(render::RenderArgs),
     /// Print what a scene contains: shapes, triangles, lights, materials, camera, bounds.
     Info {
-        /// Scene file (.toml).
+        /// Scene file (.toml, or Mitsuba 3 .xml).
         scene: PathBuf,
+        #[command(flatten)]
+        load: render::LoadArgs,
     },
     /// Print an IES LM-63 photometric profile's header, integrated lumens, peak intensity
     /// and beam angle.
@@ -73,7 +75,7 @@ fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Render(args) => render::run(args),
-        Command::Info { scene } => info::run(&scene).map(|()| ExitCode::SUCCESS),
+        Command::Info { scene, load } => info::run(&scene, &load).map(|()| ExitCode::SUCCESS),
         Command::Ies { file, plot } => ies::run(&file, plot.as_deref()).map(|()| ExitCode::SUCCESS),
     };
     match result {

@@ -20,10 +20,45 @@ use crate::output::{write_image, ImageFormat, LinearImage};
 use crate::tonemap::{DisplayTransform, Tonemap};
 use crate::{MisArg, UserError};
 
+/// How a scene file is read: parameters and strictness.
+#[derive(Args)]
+pub struct LoadArgs {
+    /// Sets a scene parameter (Mitsuba's `$name`), overriding the file's default.
+    #[arg(short = 'D', value_name = "NAME=VALUE", value_parser = parse_define)]
+    define: Vec<(String, String)>,
+    /// Warn about and skip what Candela does not support instead of failing.
+    #[arg(long)]
+    lenient: bool,
+}
+
+fn parse_define(s: &str) -> Result<(String, String), String> {
+    match s.split_once('=') {
+        Some((k, v)) if !k.trim().is_empty() => Ok((k.trim().to_string(), v.to_string())),
+        _ => Err(format!("expected NAME=VALUE, got \"{s}\"")),
+    }
+}
+
+impl LoadArgs {
+    /// Loads the scene, printing each warning to stderr.
+    pub fn load(&self, path: &std::path::Path) -> Result<SceneDesc, UserError> {
+        let options = candela_scene::LoadOptions {
+            defines: self.define.clone(),
+            lenient: self.lenient,
+        };
+        let loaded = candela_scene::load_scene_with(path, &options)?;
+        for w in &loaded.warnings {
+            eprintln!("candela: warning: {w}");
+        }
+        Ok(loaded.desc)
+    }
+}
+
 #[derive(Args)]
 pub struct RenderArgs {
-    /// Scene file (.toml).
+    /// Scene file (.toml, or Mitsuba 3 .xml).
     scene: PathBuf,
+    #[command(flatten)]
+    load: LoadArgs,
     /// Output image: .exr, .pfm (linear) or .png (sRGB).
     #[arg(short, long)]
     output: PathBuf,
@@ -164,7 +199,7 @@ fn install_interrupt_handler() {
 pub fn run(args: RenderArgs) -> Result<ExitCode, UserError> {
     // Fail on a bad output name before spending any time rendering.
     ImageFormat::from_path(&args.output)?;
-    let mut desc = candela_scene::load_scene(&args.scene)?;
+    let mut desc = args.load.load(&args.scene)?;
     args.apply_overrides(&mut desc);
     let scene = candela_core::build::build(&desc)?;
     let s = &scene.settings;

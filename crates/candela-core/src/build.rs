@@ -527,6 +527,7 @@ fn build_material(bsdf: &BsdfDesc, span: &Span) -> Result<Material, BuildError> 
             map: build_texture(map, span, "normal_map")?,
             inner: Box::new(build_material(inner, span)?),
         },
+        BsdfDesc::OneSided(inner) => Material::OneSided(Box::new(build_material(inner, span)?)),
     })
 }
 

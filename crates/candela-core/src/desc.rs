@@ -194,6 +194,9 @@ pub enum BsdfDesc {
         map: TextureDesc,
         inner: Box<BsdfDesc>,
     },
+    /// The inner BSDF on the front (the side the shading normal points to) and black
+    /// from the back, as Mitsuba's reflective BSDFs are unless wrapped in `twosided`.
+    OneSided(Box<BsdfDesc>),
 }
 
 /// A colour (or, read through one channel, a scalar) that may vary over a surface.

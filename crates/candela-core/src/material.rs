@@ -33,6 +33,8 @@ pub enum Material {
         map: Texture,
         inner: Box<Material>,
     },
+    /// Black from the back: see [`crate::desc::BsdfDesc::OneSided`].
+    OneSided(Box<Material>),
 }
 
 impl Material {
@@ -50,6 +52,10 @@ impl Material {
                 let n = normal_mapped(ns, ng, dpdu, map.eval(uv));
                 inner.bsdf_with_tangent(n, ng, uv, dpdu)
             }
+            Material::OneSided(inner) => Bsdf {
+                one_sided: true,
+                ..inner.bsdf_with_tangent(ns, ng, uv, dpdu)
+            },
             _ => Bsdf::with_tangent(ns, ng, dpdu, self.lobe(uv)),
         }
     }
@@ -73,7 +79,7 @@ impl Material {
                 metallic.eval_scalar(uv),
                 roughness.eval_scalar(uv),
             )),
-            Material::NormalMap { inner, .. } => inner.lobe(uv),
+            Material::NormalMap { inner, .. } | Material::OneSided(inner) => inner.lobe(uv),
         }
     }
 }
@@ -128,5 +134,29 @@ mod tests {
                 assert!(n.is_finite() && n.dot(ng) >= 0.1, "{texel} {t}: {n}");
             }
         }
+    }
+}
+
+#[cfg(test)]
+mod one_sided_tests {
+    use super::*;
+
+    #[test]
+    fn one_sided_is_black_from_the_back_only() {
+        let diffuse = Material::Diffuse {
+            albedo: Texture::Constant(Vec3::splat(0.5)),
+        };
+        let two = diffuse.bsdf(Vec3::Z, Vec3::Z, Vec2::ZERO);
+        let one = Material::OneSided(Box::new(diffuse)).bsdf(Vec3::Z, Vec3::Z, Vec2::ZERO);
+        let (front, back) = (Vec3::new(0.3, 0.0, 0.9).normalize(), -Vec3::Z);
+        let wi = Vec3::new(-0.2, 0.1, 0.8).normalize();
+        assert_eq!(one.f(front, wi), two.f(front, wi));
+        assert_eq!(one.pdf(front, wi), two.pdf(front, wi));
+        assert!(one.sample(front, 0.5, Vec2::splat(0.3)).is_some());
+        // From the back the two-sided diffuse reflects; the one-sided one is black.
+        assert!(two.f(back, -wi).max_element() > 0.0);
+        assert_eq!(one.f(back, -wi), Vec3::ZERO);
+        assert_eq!(one.pdf(back, -wi), 0.0);
+        assert!(one.sample(back, 0.5, Vec2::splat(0.3)).is_none());
     }
 }

@@ -2,7 +2,8 @@
 //! here; errors carry the file, line and column they refer to.
 //!
 //! One module per format: [`toml_scene`] reads Candela's own scene format (see
-//! `docs/scene-format.md`), [`obj`] and [`ply`] read triangle meshes. A new scene format
+//! `docs/scene-format.md`), [`mitsuba`] a subset of Mitsuba 3's XML (see
+//! `docs/mitsuba.md`), [`obj`] and [`ply`] read triangle meshes. A new scene format
 //! plugs in as a module and one arm of the match in [`load_scene`].
 //!
 //! ```
@@ -47,6 +48,24 @@ mod toml_values;
 pub use toml_scene::parse_toml_scene;
 
 pub mod ies;
+pub mod mitsuba;
+
+/// How to load a scene: parameters and strictness (used by formats that have them).
+#[derive(Clone, Debug, Default)]
+pub struct LoadOptions {
+    /// `name=value` parameters, e.g. Mitsuba's `$name` (`-D name=value` on the CLI); they
+    /// take precedence over the file's own defaults.
+    pub defines: Vec<(String, String)>,
+    /// Warn about and skip what Candela does not support, instead of failing.
+    pub lenient: bool,
+}
+
+/// A loaded scene and the warnings met on the way (already `file:line:col: …`).
+#[derive(Clone, Debug)]
+pub struct LoadedScene {
+    pub desc: SceneDesc,
+    pub warnings: Vec<String>,
+}
 
 /// A file that could not be loaded, with where and why. Displays as
 /// `file:line:col: message`.
@@ -121,8 +140,14 @@ pub fn load_mesh(path: &Path) -> Result<MeshDesc, MeshError> {
     }
 }
 
-/// Loads a scene file, choosing the format by its extension.
+/// Loads a scene file, choosing the format by its extension, with default options and
+/// warnings dropped; see [`load_scene_with`].
 pub fn load_scene(path: &Path) -> Result<SceneDesc, LoadError> {
+    load_scene_with(path, &LoadOptions::default()).map(|l| l.desc)
+}
+
+/// Loads a scene file (`.toml` or Mitsuba `.xml`), choosing the format by its extension.
+pub fn load_scene_with(path: &Path, options: &LoadOptions) -> Result<LoadedScene, LoadError> {
     let file_span = || Span::new(path.display().to_string(), 1, 1);
     let ext = path
         .extension()
@@ -132,15 +157,20 @@ pub fn load_scene(path: &Path) -> Result<SceneDesc, LoadError> {
         "toml" => {
             let text = std::fs::read_to_string(path)
                 .map_err(|e| LoadError::new(file_span(), format!("cannot read scene file: {e}")))?;
-            parse_toml_scene(&text, path)
+            let desc = parse_toml_scene(&text, path)?;
+            Ok(LoadedScene {
+                desc,
+                warnings: Vec::new(),
+            })
         }
+        "xml" => mitsuba::load_mitsuba(path, options),
         "" => Err(LoadError::new(
             file_span(),
-            "scene file has no extension; expected .toml",
+            "scene file has no extension; expected .toml or .xml",
         )),
         other => Err(LoadError::new(
             file_span(),
-            format!("unsupported scene format \".{other}\"; supported: .toml"),
+            format!("unsupported scene format \".{other}\"; supported: .toml, .xml"),
         )),
     }
 }
@@ -204,7 +234,7 @@ mod tests {
 
     #[test]
     fn other_extensions_are_named_in_the_error() {
-        for ext in ["xml", "gltf", "glb"] {
+        for ext in ["gltf", "glb"] {
             let name = format!("scene.{ext}");
             let e = load_scene(Path::new(&name)).unwrap_err();
             assert_eq!(e.span, Span::new(name.as_str(), 1, 1));

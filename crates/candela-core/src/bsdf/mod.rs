@@ -179,6 +179,8 @@ pub struct Bsdf {
     /// disagree.
     pub ng: Vec3,
     pub lobe: Lobe,
+    /// Black when `wo` is below the shading frame (imported one-sided BSDFs).
+    pub one_sided: bool,
 }
 
 impl Bsdf {
@@ -187,6 +189,7 @@ impl Bsdf {
             frame: Frame::from_z(ns),
             ng,
             lobe,
+            one_sided: false,
         }
     }
 
@@ -206,6 +209,7 @@ impl Bsdf {
             },
             ng,
             lobe,
+            one_sided: false,
         }
     }
 
@@ -217,9 +221,14 @@ impl Bsdf {
         geometric_reflection == shading_reflection
     }
 
+    /// Whether `wo` (local) sees nothing: grazing, or the back of a one-sided BSDF.
+    fn blind(&self, lo: Vec3) -> bool {
+        lo.z == 0.0 || (self.one_sided && lo.z < 0.0)
+    }
+
     pub fn f(&self, wo: Vec3, wi: Vec3) -> Vec3 {
         let (lo, li) = (self.frame.to_local(wo), self.frame.to_local(wi));
-        if lo.z == 0.0 || !self.sides_agree(wo, wi, lo, li) {
+        if self.blind(lo) || !self.sides_agree(wo, wi, lo, li) {
             return Vec3::ZERO;
         }
         self.lobe.f(lo, li)
@@ -227,7 +236,7 @@ impl Bsdf {
 
     pub fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
         let (lo, li) = (self.frame.to_local(wo), self.frame.to_local(wi));
-        if lo.z == 0.0 || !self.sides_agree(wo, wi, lo, li) {
+        if self.blind(lo) || !self.sides_agree(wo, wi, lo, li) {
             return 0.0;
         }
         self.lobe.pdf(lo, li)
@@ -235,7 +244,7 @@ impl Bsdf {
 
     pub fn sample(&self, wo: Vec3, u_lobe: f32, u: Vec2) -> Option<BsdfSample> {
         let lo = self.frame.to_local(wo);
-        if lo.z == 0.0 {
+        if self.blind(lo) {
             return None;
         }
         let s = self.lobe.sample(lo, u_lobe, u)?;

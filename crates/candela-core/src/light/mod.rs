@@ -14,9 +14,9 @@
 pub mod blackbody;
 mod bounds;
 mod directional;
-mod goniometric;
 mod environment;
 pub mod envmap;
+mod goniometric;
 mod point;
 mod profile;
 mod projector;
@@ -26,8 +26,8 @@ mod triangle;
 
 pub use bounds::{cone_measure, cone_union, ImportanceBounds, LightBounds};
 pub use directional::DirectionalLight;
-pub use goniometric::GoniometricLight;
 pub use environment::{EnvironmentLight, EnvironmentMap, EnvironmentSampling};
+pub use goniometric::GoniometricLight;
 pub use point::PointLight;
 pub use profile::LightProfile;
 pub use projector::ProjectorLight;

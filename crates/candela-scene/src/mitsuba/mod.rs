@@ -1,0 +1,144 @@
+//! Mitsuba 3 XML scenes (a subset; see `docs/mitsuba.md`).
+//!
+//! Three stages, as in Mitsuba's own loader: [`parse`] turns the XML (with `<default>`,
+//! `$param`, `<include>`) into a node tree with source spans; the mapping modules turn
+//! each plugin into Candela's description; whatever a plugin leaves unread is an error
+//! naming it (a warning under `lenient`), so nothing is silently dropped.
+
+mod bsdfs;
+mod emitters;
+mod parse;
+mod sensor;
+mod shapes;
+mod transform;
+
+use std::collections::HashMap;
+use std::path::Path;
+
+use candela_core::desc::SceneDesc;
+use glam::Vec3;
+
+use crate::{LoadError, LoadOptions, LoadedScene};
+use parse::Node;
+
+pub use sensor::candela_max_depth;
+
+/// Loads a Mitsuba 3 XML scene.
+pub fn load_mitsuba(path: &Path, options: &LoadOptions) -> Result<LoadedScene, LoadError> {
+    let root = parse::parse_file(path, &options.defines)?;
+    let mut ctx = Ctx {
+        lenient: options.lenient,
+        base: path.parent().unwrap_or(Path::new("")).to_path_buf(),
+        warnings: Vec::new(),
+        bsdf_ids: HashMap::new(),
+        desc: SceneDesc::default(),
+    };
+    // Mitsuba's default integrator is `path` with unlimited depth.
+    ctx.desc.render.max_depth = candela_max_depth(-1).expect("-1 is valid");
+    // Named BSDFs first, so that shapes may refer to them wherever they are defined.
+    for c in root.children.iter().filter(|c| c.tag == "bsdf") {
+        c.used.set(true);
+        let name = bsdfs::material(&mut ctx, c)?;
+        if let Some(id) = c.attr("id") {
+            ctx.bsdf_ids.insert(id.to_string(), name);
+        }
+    }
+    for c in &root.children {
+        match c.tag.as_str() {
+            "bsdf" => {}
+            "shape" => shapes::shape(&mut ctx, c)?,
+            "emitter" => emitters::emitter(&mut ctx, c)?,
+            "sensor" => sensor::sensor(&mut ctx, c)?,
+            "integrator" => sensor::integrator(&mut ctx, c)?,
+            _ => ctx.unsupported(c, format!("<{}> is not supported", describe(c)))?,
+        }
+        c.used.set(true);
+    }
+    Ok(LoadedScene {
+        desc: ctx.desc,
+        warnings: ctx.warnings,
+    })
+}
+
+/// What the mapping builds up, and how strict it is.
+pub(crate) struct Ctx {
+    pub lenient: bool,
+    /// Folder of the scene file: relative file names start there.
+    pub base: std::path::PathBuf,
+    pub warnings: Vec<String>,
+    /// Material name of each BSDF `id`.
+    pub bsdf_ids: HashMap<String, String>,
+    pub desc: SceneDesc,
+}
+
+impl Ctx {
+    /// Something outside the subset: an error, or under `lenient` a warning (and the
+    /// caller skips it or uses the closest thing Candela has).
+    pub fn unsupported(&mut self, node: &Node, message: String) -> Result<(), LoadError> {
+        mark_all_used(node);
+        let e = node.error(message);
+        if self.lenient {
+            self.warnings.push(format!("{e} (skipped: --lenient)"));
+            Ok(())
+        } else {
+            Err(e)
+        }
+    }
+
+    /// A difference Candela's image will show, always only a warning.
+    pub fn warn(&mut self, node: &Node, message: impl Into<String>) {
+        self.warnings.push(node.error(message).to_string());
+    }
+
+    /// Reports every child of a plugin that its mapping did not read.
+    pub fn check_unused(&mut self, node: &Node) -> Result<(), LoadError> {
+        for c in node.children.iter().filter(|c| !c.used.get()) {
+            let what = match c.attr("name") {
+                Some(n) => format!("<{} name=\"{n}\">", c.tag),
+                None => format!("<{}>", describe(c)),
+            };
+            self.unsupported(c, format!("{what} is not supported in {}", describe(node)))?;
+        }
+        Ok(())
+    }
+
+    /// A colour property, or `default` when it is absent; a texture in its place (not
+    /// supported yet) is an error, or under `lenient` a warning and `default`.
+    pub fn color(&mut self, node: &Node, name: &str, default: Vec3) -> Result<Vec3, LoadError> {
+        match node
+            .children
+            .iter()
+            .find(|c| c.tag == "texture" && c.name() == name)
+        {
+            Some(t) => {
+                self.unsupported(
+                    t,
+                    format!(
+                        "<texture type=\"{}\"> as \"{name}\" is not supported yet",
+                        t.kind()
+                    ),
+                )?;
+                Ok(default)
+            }
+            None => Ok(node.color(name)?.unwrap_or(default)),
+        }
+    }
+
+    /// A unique material name for an unnamed BSDF.
+    pub fn fresh_name(&self, node: &Node) -> String {
+        format!("{}@{}:{}", node.kind(), node.span.line, node.span.col)
+    }
+}
+
+fn mark_all_used(node: &Node) {
+    node.used.set(true);
+    node.children.iter().for_each(mark_all_used);
+}
+
+/// `shape type="obj"` style: the element with its plugin type.
+pub(crate) fn describe(n: &Node) -> String {
+    match n.attr("type") {
+        Some(t) => format!("{} type=\"{t}\"", n.tag),
+        None => n.tag.clone(),
+    }
+}

@@ -1,0 +1,334 @@
+//! Mitsuba XML to a neutral node tree: `<default>` and `$param` substitution, `<include>`
+//! spliced in, every element with its source span. Mapping to Candela happens later, on
+//! this tree (Mitsuba's own loader has the same parse → check → build stages).
+
+use std::cell::Cell;
+use std::collections::HashMap;
+use std::path::Path;
+
+use candela_core::desc::Span;
+use glam::Vec3;
+
+use crate::{LoadError, Source};
+
+/// How deep `<include>`s may nest before we call it a cycle.
+const MAX_INCLUDE_DEPTH: usize = 16;
+
+/// One XML element after substitution: a plugin (`shape`, `bsdf`, …), a property
+/// (`float`, `rgb`, …), a `transform` step, or a `ref`.
+#[derive(Debug)]
+pub(crate) struct Node {
+    pub tag: String,
+    pub attrs: Vec<(String, String)>,
+    pub children: Vec<Node>,
+    pub span: Span,
+    /// Set when a plugin's mapping reads this property; what is left unread is reported.
+    pub used: Cell<bool>,
+}
+
+impl Node {
+    pub fn attr(&self, name: &str) -> Option<&str> {
+        self.attrs
+            .iter()
+            .find(|(k, _)| k == name)
+            .map(|(_, v)| v.as_str())
+    }
+
+    /// An attribute that must be there.
+    pub fn req(&self, name: &str) -> Result<&str, LoadError> {
+        self.attr(name)
+            .ok_or_else(|| self.error(format!("<{}> lacks the attribute \"{name}\"", self.tag)))
+    }
+
+    /// The plugin type (`type="…"`).
+    pub fn kind(&self) -> &str {
+        self.attr("type").unwrap_or("")
+    }
+
+    /// The property name (`name="…"`).
+    pub fn name(&self) -> &str {
+        self.attr("name").unwrap_or("")
+    }
+
+    pub fn error(&self, message: impl Into<String>) -> LoadError {
+        LoadError::new(self.span.clone(), message)
+    }
+
+    /// The child property called `name`, marked as used.
+    pub fn prop(&self, name: &str) -> Option<&Node> {
+        let n = self
+            .children
+            .iter()
+            .find(|c| c.name() == name && is_property(&c.tag))?;
+        n.used.set(true);
+        Some(n)
+    }
+
+    /// Child plugins with tag `tag` (`bsdf`, `emitter`, …), marked as used.
+    pub fn plugins<'a>(&'a self, tag: &'a str) -> impl Iterator<Item = &'a Node> + 'a {
+        self.children
+            .iter()
+            .filter(move |c| c.tag == tag)
+            .inspect(|c| c.used.set(true))
+    }
+
+    pub fn float(&self, name: &str) -> Result<Option<f32>, LoadError> {
+        self.prop(name)
+            .map(|p| p.typed(&["float", "integer"])?.parse_f32(p.req("value")?))
+            .transpose()
+    }
+
+    pub fn integer(&self, name: &str) -> Result<Option<i64>, LoadError> {
+        self.prop(name)
+            .map(|p| {
+                let v = p.typed(&["integer"])?.req("value")?;
+                v.trim()
+                    .parse::<i64>()
+                    .map_err(|_| p.error(format!("\"{v}\" is not an integer")))
+            })
+            .transpose()
+    }
+
+    pub fn boolean(&self, name: &str) -> Result<Option<bool>, LoadError> {
+        self.prop(name)
+            .map(|p| match p.typed(&["boolean"])?.req("value")?.trim() {
+                "true" => Ok(true),
+                "false" => Ok(false),
+                v => Err(p.error(format!("\"{v}\" is not a boolean (true or false)"))),
+            })
+            .transpose()
+    }
+
+    pub fn string(&self, name: &str) -> Result<Option<&str>, LoadError> {
+        self.prop(name)
+            .map(|p| p.typed(&["string"])?.req("value"))
+            .transpose()
+    }
+
+    /// A colour: `rgb`, a constant `spectrum`, or a `float` (grey).
+    pub fn color(&self, name: &str) -> Result<Option<Vec3>, LoadError> {
+        let Some(p) = self.prop(name) else {
+            return Ok(None);
+        };
+        match p.tag.as_str() {
+            "float" => Ok(Some(Vec3::splat(p.parse_f32(p.req("value")?)?))),
+            "rgb" => p.parse_vec3(p.req("value")?, true).map(Some),
+            "spectrum" => {
+                let v = p.req("value")?;
+                if v.contains(':') {
+                    return Err(p.error(
+                        "spectrum given as wavelength:value pairs is not supported; use <rgb>",
+                    ));
+                }
+                Ok(Some(Vec3::splat(p.parse_f32(v)?)))
+            }
+            "texture" => Err(p.error(format!(
+                "texture \"{}\" as \"{name}\" is not supported yet",
+                p.kind()
+            ))),
+            other => Err(p.error(format!("\"{name}\" must be a colour, not <{other}>"))),
+        }
+    }
+
+    /// A `point` or `vector`: `x`/`y`/`z` attributes (missing ones are 0) or `value`.
+    pub fn point(&self, name: &str) -> Result<Option<Vec3>, LoadError> {
+        self.prop(name)
+            .map(|p| p.typed(&["point", "vector"])?.xyz(0.0))
+            .transpose()
+    }
+
+    fn typed(&self, tags: &[&str]) -> Result<&Node, LoadError> {
+        if tags.contains(&self.tag.as_str()) {
+            Ok(self)
+        } else {
+            Err(self.error(format!(
+                "\"{}\" must be <{}>, not <{}>",
+                self.name(),
+                tags.join("> or <"),
+                self.tag
+            )))
+        }
+    }
+
+    /// A vector from `value="x, y, z"` or from `x`, `y`, `z` attributes defaulting to
+    /// `missing`.
+    pub fn xyz(&self, missing: f32) -> Result<Vec3, LoadError> {
+        if let Some(v) = self.attr("value") {
+            return self.parse_vec3(v, false);
+        }
+        let c = |a: &str| self.attr(a).map_or(Ok(missing), |v| self.parse_f32(v));
+        Ok(Vec3::new(c("x")?, c("y")?, c("z")?))
+    }
+
+    pub fn parse_f32(&self, v: &str) -> Result<f32, LoadError> {
+        match v.trim().parse::<f32>() {
+            Ok(x) if x.is_finite() => Ok(x),
+            _ => Err(self.error(format!("\"{v}\" is not a finite number"))),
+        }
+    }
+
+    /// Numbers separated by commas and/or spaces.
+    pub fn parse_list(&self, v: &str) -> Result<Vec<f32>, LoadError> {
+        v.split(|c: char| c == ',' || c.is_whitespace())
+            .filter(|s| !s.is_empty())
+            .map(|s| self.parse_f32(s))
+            .collect()
+    }
+
+    /// Three numbers; with `splat`, one number stands for all three.
+    pub fn parse_vec3(&self, v: &str, splat: bool) -> Result<Vec3, LoadError> {
+        match *self.parse_list(v)?.as_slice() {
+            [x] if splat => Ok(Vec3::splat(x)),
+            [x, y, z] => Ok(Vec3::new(x, y, z)),
+            _ => Err(self.error(format!("\"{v}\" must be three numbers"))),
+        }
+    }
+}
+
+/// Elements that are properties of the plugin they sit in.
+pub(crate) fn is_property(tag: &str) -> bool {
+    matches!(
+        tag,
+        "float"
+            | "integer"
+            | "boolean"
+            | "string"
+            | "rgb"
+            | "spectrum"
+            | "point"
+            | "vector"
+            | "transform"
+            | "texture"
+    )
+}
+
+/// Parses a scene file (and what it includes) into its `<scene>` node. `defines` are the
+/// `-D name=value` parameters, which take precedence over `<default>`s.
+pub(crate) fn parse_file(path: &Path, defines: &[(String, String)]) -> Result<Node, LoadError> {
+    let mut p = Parser {
+        params: defines.iter().cloned().collect(),
+    };
+    let span = Span::new(path.display().to_string(), 1, 1);
+    let text = std::fs::read_to_string(path)
+        .map_err(|e| LoadError::new(span, format!("cannot read scene file: {e}")))?;
+    p.parse_text(path, &text, 0)
+}
+
+struct Parser {
+    /// `-D` parameters, then the `<default>`s met so far.
+    params: HashMap<String, String>,
+}
+
+impl Parser {
+    fn parse_text(&mut self, path: &Path, text: &str, depth: usize) -> Result<Node, LoadError> {
+        let src = Source::new(path, text);
+        let doc = roxmltree::Document::parse(text).map_err(|e| {
+            let pos = e.pos();
+            LoadError::new(
+                Span::new(src.file.clone(), pos.row, pos.col),
+                format!("XML: {e}"),
+            )
+        })?;
+        let root = doc.root_element();
+        if root.tag_name().name() != "scene" {
+            return Err(src.error(
+                root.range().start,
+                format!(
+                    "the root element must be <scene>, not <{}>",
+                    root.tag_name().name()
+                ),
+            ));
+        }
+        if let Some(v) = root.attribute("version") {
+            let major = v.split('.').next().and_then(|m| m.parse::<u32>().ok());
+            if major.is_none_or(|m| m < 2) {
+                return Err(src.error(
+                    root.range().start,
+                    format!("scene version \"{v}\" is not supported; Mitsuba 2 or 3 syntax (version=\"3.0.0\") is"),
+                ));
+            }
+        }
+        // Defaults first, wherever they are among the scene's children.
+        for d in root.children().filter(|c| c.has_tag_name("default")) {
+            let at = d.range().start;
+            let (Some(name), Some(value)) = (d.attribute("name"), d.attribute("value")) else {
+                return Err(src.error(at, "<default> needs \"name\" and \"value\""));
+            };
+            // A default only fills a parameter nobody has set (-D, or an earlier file).
+            self.params
+                .entry(name.to_string())
+                .or_insert_with(|| value.to_string());
+        }
+        let mut scene = self.convert(&src, root)?;
+        let mut children = Vec::new();
+        for c in std::mem::take(&mut scene.children) {
+            match c.tag.as_str() {
+                "default" => {}
+                "include" => children.extend(self.include(path, &c, depth)?.children),
+                _ => children.push(c),
+            }
+        }
+        scene.children = children;
+        Ok(scene)
+    }
+
+    fn include(&mut self, path: &Path, node: &Node, depth: usize) -> Result<Node, LoadError> {
+        if depth >= MAX_INCLUDE_DEPTH {
+            return Err(node.error("includes nest too deep (is a file including itself?)"));
+        }
+        let name = node.req("filename")?;
+        let file = path.parent().unwrap_or(Path::new("")).join(name);
+        let text = std::fs::read_to_string(&file).map_err(|e| {
+            node.error(format!("cannot read included file {}: {e}", file.display()))
+        })?;
+        self.parse_text(&file, &text, depth + 1)
+    }
+
+    fn convert(&self, src: &Source, e: roxmltree::Node) -> Result<Node, LoadError> {
+        let at = e.range().start;
+        let mut attrs = Vec::new();
+        for a in e.attributes() {
+            let value = self
+                .substitute(a.value())
+                .map_err(|m| src.error(a.range().start, m))?;
+            attrs.push((a.name().to_string(), value));
+        }
+        let children = e
+            .children()
+            .filter(|c| c.is_element())
+            .map(|c| self.convert(src, c))
+            .collect::<Result<_, _>>()?;
+        Ok(Node {
+            tag: e.tag_name().name().to_string(),
+            attrs,
+            children,
+            span: src.span(at),
+            used: Cell::new(false),
+        })
+    }
+
+    /// Replaces every `$name` by its parameter's value.
+    fn substitute(&self, value: &str) -> Result<String, String> {
+        let mut out = String::with_capacity(value.len());
+        let mut rest = value;
+        while let Some(i) = rest.find('$') {
+            out.push_str(&rest[..i]);
+            let after = &rest[i + 1..];
+            let len = after
+                .find(|c: char| !(c.is_ascii_alphanumeric() || c == '_'))
+                .unwrap_or(after.len());
+            let name = &after[..len];
+            match self.params.get(name) {
+                Some(v) => out.push_str(v),
+                None => {
+                    return Err(format!(
+                    "undefined parameter \"${name}\" (give it with -D {name}=VALUE or a <default>)"
+                ))
+                }
+            }
+            rest = &after[len..];
+        }
+        out.push_str(rest);
+        Ok(out)
+    }
+}

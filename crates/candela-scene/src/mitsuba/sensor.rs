@@ -1,0 +1,220 @@
+//! `<sensor>` (with its `<film>` and `<sampler>`) and `<integrator>`: the camera and the
+//! render settings.
+
+use candela_core::desc::{ApertureDesc, ApertureSizeDesc, CameraDesc, FocusDesc, LensDesc};
+use glam::{Mat4, Vec3};
+
+use super::parse::Node;
+use super::{describe, transform, Ctx};
+use crate::LoadError;
+
+/// Candela's depth for Mitsuba's "unlimited" (−1); Russian roulette ends paths long
+/// before it.
+const UNLIMITED_DEPTH: u32 = 1024;
+
+/// Mitsuba's `max_depth` m as Candela's `max_depth`. Mitsuba counts path vertices after
+/// the camera, so m = 1 shows emitters only (Candela's 0) and m = 2 is direct light
+/// (Candela's 1); −1 is unlimited. m = 0 renders black in Mitsuba, which Candela cannot
+/// express.
+pub fn candela_max_depth(m: i64) -> Result<u32, String> {
+    match m {
+        -1 => Ok(UNLIMITED_DEPTH),
+        1.. => Ok(u32::try_from(m - 1)
+            .unwrap_or(UNLIMITED_DEPTH)
+            .min(UNLIMITED_DEPTH)),
+        0 => Err("max_depth 0 (a black image) is not supported; use 1 or more".into()),
+        _ => Err(format!(
+            "max_depth {m} is invalid: use -1 (unlimited) or 1 or more"
+        )),
+    }
+}
+
+pub(crate) fn integrator(ctx: &mut Ctx, node: &Node) -> Result<(), LoadError> {
+    if node.kind() != "path" {
+        return ctx.unsupported(
+            node,
+            format!("<{}> is not supported (only \"path\" is)", describe(node)),
+        );
+    }
+    if let Some(m) = node.integer("max_depth")? {
+        let p = node.prop("max_depth").expect("read just now");
+        ctx.desc.render.max_depth = candela_max_depth(m).map_err(|e| p.error(e))?;
+    } else {
+        ctx.desc.render.max_depth = UNLIMITED_DEPTH;
+    }
+    if let Some(rr) = node.integer("rr_depth")? {
+        if rr != 5 {
+            let p = node.prop("rr_depth").expect("read just now");
+            ctx.warn(
+                p,
+                "rr_depth is ignored: Candela's Russian roulette starts after 3 bounces",
+            );
+        }
+    }
+    if node.boolean("hide_emitters")? == Some(true) {
+        let p = node.prop("hide_emitters").expect("read just now");
+        ctx.unsupported(p, "hide_emitters=true is not supported yet".into())?;
+    }
+    ctx.check_unused(node)
+}
+
+pub(crate) fn sensor(ctx: &mut Ctx, node: &Node) -> Result<(), LoadError> {
+    match node.kind() {
+        "perspective" | "thinlens" => {}
+        _ => return ctx.unsupported(node, format!("<{}> is not supported", describe(node))),
+    }
+    for f in node.plugins("film") {
+        film(ctx, f)?;
+    }
+    for s in node.plugins("sampler") {
+        sampler(ctx, s)?;
+    }
+    let to_world = match node.prop("to_world") {
+        Some(t) => transform::transform(t)?,
+        None => Mat4::IDENTITY,
+    };
+    if node.prop("focal_length").is_some() {
+        return Err(node.error("focal_length is not supported; give the fov"));
+    }
+    let fov = node
+        .float("fov")?
+        .ok_or_else(|| node.error("perspective sensor needs a fov"))?;
+    let axis = node.string("fov_axis")?.unwrap_or("x");
+    let r = &ctx.desc.render;
+    let aspect = r.width as f32 / r.height as f32;
+    let fov_y_deg = vertical_fov(fov, axis, aspect).ok_or_else(|| {
+        node.error(format!(
+            "fov_axis \"{axis}\" is not one of x, y, diagonal, smaller, larger"
+        ))
+    })?;
+    for clip in ["near_clip", "far_clip"] {
+        node.float(clip)?;
+    }
+    ctx.desc.camera = camera(ctx, node, to_world, fov_y_deg)?;
+    if node.kind() == "thinlens" {
+        ctx.desc.camera.lens = Some(thin_lens(node)?);
+    }
+    ctx.check_unused(node)
+}
+
+/// Mitsuba's camera frame looks along +z with +y up and the image's right along −x (see
+/// `transform::look_at`); Candela's camera is position, target and up.
+fn camera(ctx: &mut Ctx, node: &Node, m: Mat4, fov_y_deg: f32) -> Result<CameraDesc, LoadError> {
+    let position = m.transform_point3(Vec3::ZERO);
+    let forward = m.transform_vector3(Vec3::Z).normalize_or_zero();
+    let up = m.transform_vector3(Vec3::Y).normalize_or_zero();
+    if forward == Vec3::ZERO || up == Vec3::ZERO {
+        return Err(node.error("the sensor's to_world is singular"));
+    }
+    // Candela's image right is forward × up; Mitsuba's is the frame's −x. They agree
+    // unless the transform mirrors.
+    if m.determinant() < 0.0 {
+        ctx.unsupported(
+            node,
+            "the sensor's to_world mirrors (negative determinant); the image would be flipped"
+                .into(),
+        )?;
+    }
+    Ok(CameraDesc {
+        position,
+        look_at: position + forward,
+        up,
+        fov_y_deg,
+        span: node.span.clone(),
+        ..CameraDesc::default()
+    })
+}
+
+/// Mitsuba's `thinlens`: a disc aperture of `aperture_radius` (scene units) focused on the
+/// plane `focus_distance` along the view axis, as Candela's thin lens.
+fn thin_lens(node: &Node) -> Result<LensDesc, LoadError> {
+    let get = |name: &str| {
+        node.float(name)?
+            .ok_or_else(|| node.error(format!("thinlens needs \"{name}\"")))
+    };
+    let (radius, focus) = (get("aperture_radius")?, get("focus_distance")?);
+    if radius < 0.0 || focus <= 0.0 {
+        return Err(node.error("thinlens needs aperture_radius >= 0 and focus_distance > 0"));
+    }
+    Ok(LensDesc {
+        focus: FocusDesc::Distance(focus),
+        size: ApertureSizeDesc::Radius(radius),
+        aperture: ApertureDesc::Disc,
+    })
+}
+
+/// The vertical field of view (degrees) of a Mitsuba `fov` along `axis` on an image of
+/// width/height `aspect`: tan(fov_y/2) = tan(fov/2)·(height/extent along the axis).
+pub(crate) fn vertical_fov(fov: f32, axis: &str, aspect: f32) -> Option<f32> {
+    let t = (fov.to_radians() * 0.5).tan();
+    let ty = match axis {
+        "x" => t / aspect,
+        "y" => t,
+        "diagonal" => t / (1.0 + aspect * aspect).sqrt(),
+        "smaller" if aspect >= 1.0 => t,
+        "smaller" => t / aspect,
+        "larger" if aspect >= 1.0 => t / aspect,
+        "larger" => t,
+        _ => return None,
+    };
+    Some((2.0 * ty.atan()).to_degrees())
+}
+
+fn film(ctx: &mut Ctx, node: &Node) -> Result<(), LoadError> {
+    if node.kind() != "hdrfilm" {
+        return ctx.unsupported(node, format!("<{}> is not supported", describe(node)));
+    }
+    let dim = |name: &str, default: u32| -> Result<u32, LoadError> {
+        match node.integer(name)? {
+            None => Ok(default),
+            Some(v) if v > 0 && v <= 1 << 16 => Ok(v as u32),
+            Some(v) => Err(node.error(format!("film {name} {v} is out of range"))),
+        }
+    };
+    ctx.desc.render.width = dim("width", 768)?;
+    ctx.desc.render.height = dim("height", 576)?;
+    // Output encoding: Candela picks it from the output file's extension.
+    for s in ["file_format", "pixel_format", "component_format"] {
+        node.string(s)?;
+    }
+    node.boolean("banner")?;
+    for f in node.plugins("rfilter") {
+        match f.kind() {
+            "box" => {}
+            "gaussian" | "tent" => ctx.warn(
+                f,
+                format!(
+                    "Candela uses a box filter; the {} filter's extra blur is not reproduced",
+                    f.kind()
+                ),
+            ),
+            _ => ctx.unsupported(f, format!("<{}> is not supported", describe(f)))?,
+        }
+        f.children.iter().for_each(|c| c.used.set(true));
+    }
+    ctx.check_unused(node)
+}
+
+fn sampler(ctx: &mut Ctx, node: &Node) -> Result<(), LoadError> {
+    match node.kind() {
+        "independent" => {}
+        "stratified" | "multijitter" | "orthogonal" | "ldsampler" => ctx.warn(
+            node,
+            "Candela samples independently; the image converges to the same result",
+        ),
+        _ => return ctx.unsupported(node, format!("<{}> is not supported", describe(node))),
+    }
+    if let Some(n) = node.integer("sample_count")? {
+        if n < 1 || n > u32::MAX as i64 {
+            return Err(node.error(format!("sample_count {n} is out of range")));
+        }
+        ctx.desc.render.spp = n as u32;
+    } else {
+        ctx.desc.render.spp = 4;
+    }
+    if let Some(seed) = node.integer("seed")? {
+        ctx.desc.render.seed = seed as u64;
+    }
+    node.boolean("jitter")?;
+    ctx.check_unused(node)
+}
