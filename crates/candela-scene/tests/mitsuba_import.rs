@@ -286,6 +286,7 @@ fn emitters_map_to_area_and_point_lights() {
                 position,
                 intensity,
             } => (position, intensity),
+            ref other => panic!("expected a point light, got {other:?}"),
         })
         .collect();
     assert_eq!(points[0], (Vec3::new(1.0, 2.0, 3.0), Vec3::splat(5.0)));
