@@ -18,6 +18,7 @@ mod environment;
 pub mod envmap;
 mod goniometric;
 mod point;
+mod positional;
 mod profile;
 mod projector;
 mod sphere;

@@ -4,7 +4,7 @@ use std::sync::Arc;
 
 use glam::Vec3;
 
-use super::{receiver_cos, LightBounds, LightSample, ShadingCtx};
+use super::{positional, LightBounds, LightSample, ShadingCtx};
 use crate::desc::ImageDesc;
 use crate::geometry::Aabb;
 use crate::math::luminance;
@@ -112,34 +112,13 @@ impl ProjectorLight {
     }
 
     pub fn sample_li(&self, ctx: &ShadingCtx) -> Option<LightSample> {
-        let to = self.position - ctx.p;
-        let d2 = to.length_squared();
-        if d2 == 0.0 {
-            return None;
-        }
-        let distance = d2.sqrt();
-        let wi = to / distance;
-        Some(LightSample {
-            radiance: self.intensity_towards(-wi) / d2,
-            wi,
-            distance,
-            pdf: 1.0,
-            is_delta: true,
-            p_light: self.position,
-            n_light: Vec3::ZERO,
-        })
+        positional::sample_li(self.position, ctx, |w| self.intensity_towards(w))
     }
 
     /// The exact potential contribution: luminance of I(ω)/d² towards `ctx` times the
     /// receiver cosine; exactly 0 where the light is dark towards the point.
     pub fn importance(&self, ctx: &ShadingCtx) -> f32 {
-        let to = ctx.p - self.position;
-        let d2 = to.length_squared();
-        if d2 == 0.0 {
-            return 0.0;
-        }
-        let w = to / d2.sqrt();
-        luminance(self.intensity_towards(w)) / d2 * receiver_cos(ctx, -w)
+        positional::importance(self.position, ctx, |w| self.intensity_towards(w))
     }
 
     /// Emission within the cone through the frustum's corners (θ_o), nothing beyond
