@@ -415,30 +415,7 @@ fn build_texture(t: &TextureDesc, span: &Span, what: &str) -> Result<Texture, Bu
         }
         TextureDesc::Image(t) => {
             let img = &t.image;
-            if img.width == 0 || img.height == 0 {
-                return err(span, format!("{what} image is empty"));
-            }
-            if img.pixels.len() != img.width as usize * img.height as usize {
-                return err(
-                    span,
-                    format!(
-                        "{what} image has {} pixels for {}x{}",
-                        img.pixels.len(),
-                        img.width,
-                        img.height
-                    ),
-                );
-            }
-            if img
-                .pixels
-                .iter()
-                .any(|p| !p.is_finite() || p.min_element() < 0.0)
-            {
-                return err(
-                    span,
-                    format!("{what} image has negative or non-finite pixels"),
-                );
-            }
+            check_image(span, &format!("{what} image"), img)?;
             check_color(span, what, t.scale)?;
             check_finite(span, what, &t.uv_transform.to_cols_array())?;
             if t.channel.is_some_and(|c| c > 2) {

@@ -15,7 +15,7 @@ use std::f32::consts::PI;
 
 use glam::Vec3;
 
-use super::{check_color, check_finite, err, BuildError};
+use super::{check_color, check_finite, check_image, err, BuildError};
 use crate::desc::{
     GeometryDesc, LightAmountDesc, LightColorDesc, LightDesc, LightKindDesc, ProfileDesc,
     SceneDesc, Span,
@@ -239,27 +239,7 @@ pub(super) fn build_light(l: &LightDesc) -> Result<Light, BuildError> {
                 }
             }
             let img = &p.image;
-            if img.width == 0 || img.height == 0 {
-                return err(span, "projector image is empty");
-            }
-            if img.pixels.len() != (img.width * img.height) as usize {
-                return err(
-                    span,
-                    format!(
-                        "projector image has {} pixels for {}x{}",
-                        img.pixels.len(),
-                        img.width,
-                        img.height
-                    ),
-                );
-            }
-            if img
-                .pixels
-                .iter()
-                .any(|c| !c.is_finite() || c.min_element() < 0.0)
-            {
-                return err(span, "projector image has a negative or non-finite pixel");
-            }
+            check_image(span, "projector image", img)?;
             let mut proj = ProjectorLight::new(
                 p.position,
                 direction,
