@@ -1,7 +1,7 @@
 //! `<transform>`: a sequence of steps, each applied after (left-multiplied onto) the ones
 //! before it, as in Mitsuba.
 
-use glam::{Mat3, Mat4, Vec3, Vec4};
+use glam::{Mat3, Mat4, Vec3};
 
 use super::parse::Node;
 use crate::LoadError;
@@ -76,19 +76,7 @@ fn rotation(k: Vec3, angle: f32) -> Mat3 {
     Mat3::IDENTITY * c + cross * s + outer * (1.0 - c)
 }
 
-/// Mitsuba's `Transform4f::look_at`: the frame's +z looks at the target, +y is up and +x
-/// is up × forward (the image's left, as Mitsuba's cameras see it).
-pub(crate) fn look_at(origin: Vec3, target: Vec3, up: Vec3) -> Option<Mat4> {
-    let dir = (target - origin).normalize_or_zero();
-    let left = up.normalize_or_zero().cross(dir).normalize_or_zero();
-    if dir == Vec3::ZERO || left == Vec3::ZERO {
-        return None;
-    }
-    let new_up = dir.cross(left);
-    Some(Mat4::from_cols(
-        left.extend(0.0),
-        new_up.extend(0.0),
-        dir.extend(0.0),
-        Vec4::new(origin.x, origin.y, origin.z, 1.0),
-    ))
-}
+/// Mitsuba's `Transform4f::look_at` is the TOML format's `look_at` step: the frame's +z
+/// looks at the target, +y is up and +x is up × forward (the image's left, as Mitsuba's
+/// cameras see it).
+pub(crate) use crate::toml_shape::look_at;
