@@ -12,37 +12,15 @@
 
 use std::path::Path;
 
-use candela_core::color::srgb_decode;
 use candela_core::desc::ImageDesc;
-use glam::Vec3;
 
-/// Loads an image as linear RGB. `.hdr` and `.exr` are taken as linear; every other
-/// format the `image` crate reads (PNG, JPEG, TGA, BMP) is taken as sRGB-encoded.
+use crate::image_texture::{load_image, Encoding};
+
+/// Loads an image as linear RGB through [`crate::image_texture::load_image`]: `.hdr` and
+/// `.exr` are linear; PNG, JPEG, TGA and BMP are taken as sRGB-encoded. An environment
+/// must also be non-empty and have finite, non-negative pixels.
 pub fn load_linear_image(path: &Path) -> Result<ImageDesc, String> {
-    let ext = path
-        .extension()
-        .map(|e| e.to_string_lossy().to_ascii_lowercase())
-        .unwrap_or_default();
-    let img = match ext.as_str() {
-        "exr" => load_exr(path)?,
-        _ => {
-            let img = image::open(path).map_err(|e| format!("cannot read image: {e}"))?;
-            let rgb = img.to_rgb32f();
-            let decode = if ext == "hdr" {
-                |v: f32| v
-            } else {
-                srgb_decode
-            };
-            ImageDesc {
-                width: rgb.width(),
-                height: rgb.height(),
-                pixels: rgb
-                    .pixels()
-                    .map(|p| Vec3::new(decode(p[0]), decode(p[1]), decode(p[2])))
-                    .collect(),
-            }
-        }
-    };
+    let img = load_image(path, Encoding::Srgb)?;
     if img.width == 0 || img.height == 0 {
         return Err("image is empty".into());
     }
@@ -54,31 +32,6 @@ pub fn load_linear_image(path: &Path) -> Result<ImageDesc, String> {
         return Err(format!("image has a negative or non-finite pixel {p}"));
     }
     Ok(img)
-}
-
-fn load_exr(path: &Path) -> Result<ImageDesc, String> {
-    use exr::prelude::*;
-    let image = read_first_rgba_layer_from_file(
-        path,
-        |res, _| {
-            (
-                res.width(),
-                vec![glam::Vec3::ZERO; res.width() * res.height()],
-            )
-        },
-        |(w, px): &mut (usize, std::vec::Vec<glam::Vec3>),
-         pos,
-         (r, g, b, _a): (f32, f32, f32, f32)| {
-            px[pos.y() * *w + pos.x()] = glam::Vec3::new(r, g, b);
-        },
-    )
-    .map_err(|e| format!("cannot read OpenEXR image: {e}"))?;
-    let size = image.layer_data.size;
-    Ok(ImageDesc {
-        width: size.width() as u32,
-        height: size.height() as u32,
-        pixels: image.layer_data.channel_data.pixels.1,
-    })
 }
 
 /// The `n × n` square at face position (`col`, `row`) of a cross.
@@ -162,6 +115,7 @@ pub fn load_cube_faces(paths: &[&Path; 6]) -> Result<[ImageDesc; 6], (usize, Str
 #[cfg(test)]
 mod tests {
     use super::*;
+    use glam::Vec3;
 
     fn numbered(w: u32, h: u32) -> ImageDesc {
         ImageDesc {

@@ -112,16 +112,15 @@ pub(crate) fn parse_environment(
     let resolve = |p: &str| -> PathBuf { base.join(p) };
     let map = if let Some(file) = e.equirect {
         let at = file.span().start;
-        let img = load_linear_image(&resolve(file.get_ref()))
-            .map_err(|m| src.error(at, format!("{}: {m}", file.get_ref())))?;
+        // Load errors name the file already.
+        let img = load_linear_image(&resolve(file.get_ref())).map_err(|m| src.error(at, m))?;
         EnvironmentMapDesc::Equirect(img)
     } else if let Some(cube) = e.cubemap {
         let at = cube.span().start;
         match cube.into_inner() {
             CubemapSpec::Cross(file) => {
-                let img = load_linear_image(&resolve(&file))
-                    .and_then(|img| split_cross(&img))
-                    .map_err(|m| src.error(at, format!("{file}: {m}")))?;
+                let img = load_linear_image(&resolve(&file)).map_err(|m| src.error(at, m))?;
+                let img = split_cross(&img).map_err(|m| src.error(at, format!("{file}: {m}")))?;
                 EnvironmentMapDesc::Cubemap(Box::new(flip_faces(img, flip)))
             }
             CubemapSpec::Faces(files) => {

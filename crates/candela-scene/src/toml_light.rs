@@ -5,7 +5,6 @@
 use std::path::Path;
 use std::sync::Arc;
 
-use candela_core::color::srgb_decode;
 use candela_core::desc::{
     DirectionalLightDesc, ImageDesc, LightAmountDesc, LightColorDesc, LightDesc, LightKindDesc,
     ProfileDesc, ProjectorLightDesc, ShapedPointDesc, SpotFalloff, SpotLightDesc,
@@ -16,6 +15,7 @@ use serde::de::IgnoredAny;
 use serde::Deserialize;
 use toml::Spanned;
 
+use crate::image_texture::{load_image, Encoding};
 use crate::toml_scene::{deserialize, item_type, Item};
 use crate::toml_values::{Num, Splat3, V3};
 use crate::{LoadError, Source};
@@ -157,8 +157,8 @@ pub(crate) fn load_ies_table(
     Ok(Arc::new(ies.table()?))
 }
 
-/// Reads an image; 8- and 16-bit images are sRGB-decoded to linear, float images (HDR,
-/// EXR) are taken as linear already.
+/// Reads an image through [`load_image`]: 8- and 16-bit images are sRGB-decoded to
+/// linear, float images (HDR, EXR) are taken as linear already.
 pub(crate) fn load_linear_image(
     src: &Source,
     base: &Path,
@@ -169,29 +169,7 @@ pub(crate) fn load_linear_image(
     if !path.is_file() {
         return Err(src.error(at, format!("image file {} does not exist", path.display())));
     }
-    let img = image::open(&path)
-        .map_err(|e| src.error(at, format!("cannot read image {}: {e}", path.display())))?;
-    let float = matches!(
-        img,
-        image::DynamicImage::ImageRgb32F(_) | image::DynamicImage::ImageRgba32F(_)
-    );
-    let rgb = img.to_rgb32f();
-    let pixels = rgb
-        .pixels()
-        .map(|p| {
-            let c = Vec3::from_array(p.0);
-            if float {
-                c
-            } else {
-                Vec3::new(srgb_decode(c.x), srgb_decode(c.y), srgb_decode(c.z))
-            }
-        })
-        .collect();
-    Ok(ImageDesc {
-        width: rgb.width(),
-        height: rgb.height(),
-        pixels,
-    })
+    load_image(&path, Encoding::Srgb).map_err(|e| src.error(at, e))
 }
 
 /// Colour and amount from `color`/`temperature`, `intensity`/`power` (or `irradiance`)
