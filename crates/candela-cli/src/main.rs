@@ -13,7 +13,7 @@ mod tonemap;
 use std::path::PathBuf;
 use std::process::ExitCode;
 
-use clap::{Parser, Subcommand, ValueEnum};
+use clap::{Parser, Subcommand};
 
 #[derive(Parser)]
 #[command(name = "candela", version, about = "A physically based path tracer")]
@@ -42,17 +42,6 @@ enum Command {
         #[arg(long)]
         plot: Option<PathBuf>,
     },
-}
-
-/// How a render is weighed between light sampling and BSDF sampling.
-#[derive(Clone, Copy, Debug, ValueEnum)]
-pub enum MisArg {
-    Balance,
-    Power,
-    /// Next event estimation only for direct light.
-    None,
-    /// BSDF sampling only (for testing).
-    Bsdf,
 }
 
 /// A user-facing failure: printed as one line, exit code 2.

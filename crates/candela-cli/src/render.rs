@@ -13,12 +13,12 @@ use candela_core::desc::{
     ApertureSizeDesc, FocusDesc, LensDesc, LightSamplerKind, MisMode, SceneDesc,
 };
 use candela_core::integrator;
-use clap::{Args, ValueEnum};
+use clap::Args;
 use indicatif::{ProgressBar, ProgressStyle};
 
 use crate::output::{write_image, ImageFormat, LinearImage};
 use crate::tonemap::{DisplayTransform, Tonemap};
-use crate::{MisArg, UserError};
+use crate::UserError;
 
 /// How a scene file is read: parameters and strictness.
 #[derive(Args)]
@@ -86,12 +86,13 @@ pub struct RenderArgs {
     /// Encode PNG with a pure power law 1/γ instead of the sRGB curve, e.g. 2.2.
     #[arg(long, value_parser = parse_gamma)]
     gamma: Option<f32>,
-    /// MIS heuristic between light and BSDF sampling.
-    #[arg(long, value_enum)]
-    mis: Option<MisArg>,
-    /// How next event estimation picks a light.
-    #[arg(long, value_enum)]
-    light_sampler: Option<LightSamplerArg>,
+    /// MIS heuristic between light and BSDF sampling: balance, power, none (light
+    /// sampling only) or bsdf (BSDF sampling only).
+    #[arg(long, value_parser = parse_name::<MisMode>)]
+    mis: Option<MisMode>,
+    /// How next event estimation picks a light: uniform, power, array, ris, bvh or ris-bvh.
+    #[arg(long, value_parser = parse_name::<LightSamplerKind>)]
+    light_sampler: Option<LightSamplerKind>,
     /// Candidates per pick of the `ris` and `ris-bvh` light samplers.
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..))]
     ris_candidates: Option<u32>,
@@ -106,14 +107,10 @@ pub struct RenderArgs {
     f_number: Option<f32>,
 }
 
-#[derive(Clone, Copy, Debug, ValueEnum)]
-pub enum LightSamplerArg {
-    Uniform,
-    Power,
-    Array,
-    Ris,
-    Bvh,
-    RisBvh,
+/// Parses a setting's name as scene files spell it, so the two cannot drift apart.
+fn parse_name<T: serde::de::DeserializeOwned>(s: &str) -> Result<T, String> {
+    use serde::de::IntoDeserializer;
+    T::deserialize(s.into_deserializer()).map_err(|e: serde::de::value::Error| e.to_string())
 }
 
 fn parse_gamma(s: &str) -> Result<f32, String> {
@@ -151,24 +148,8 @@ impl RenderArgs {
         if let Some((w, h)) = self.res {
             (r.width, r.height) = (w, h);
         }
-        if let Some(m) = self.mis {
-            r.mis = match m {
-                MisArg::Balance => MisMode::Balance,
-                MisArg::Power => MisMode::Power,
-                MisArg::None => MisMode::NeeOnly,
-                MisArg::Bsdf => MisMode::BsdfOnly,
-            };
-        }
-        if let Some(l) = self.light_sampler {
-            r.light_sampler = match l {
-                LightSamplerArg::Uniform => LightSamplerKind::Uniform,
-                LightSamplerArg::Power => LightSamplerKind::Power,
-                LightSamplerArg::Array => LightSamplerKind::Array,
-                LightSamplerArg::Ris => LightSamplerKind::Ris,
-                LightSamplerArg::Bvh => LightSamplerKind::Bvh,
-                LightSamplerArg::RisBvh => LightSamplerKind::RisBvh,
-            };
-        }
+        r.mis = self.mis.unwrap_or(r.mis);
+        r.light_sampler = self.light_sampler.unwrap_or(r.light_sampler);
         if let Some(n) = self.ris_candidates {
             r.ris_candidates = n;
         }

@@ -478,8 +478,10 @@ pub enum EnvironmentMapDesc {
     Cubemap(Box<[ImageDesc; 6]>),
 }
 
-/// How to weigh next event estimation against BSDF sampling.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+/// How to weigh next event estimation against BSDF sampling. Its names in scene files and
+/// on the command line are `balance`, `power`, `none` and `bsdf`.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Deserialize)]
+#[serde(rename_all = "kebab-case")]
 pub enum MisMode {
     /// Balance heuristic (Veach 1997, §9.2.2); the default, as in the course notes.
     #[default]
@@ -488,13 +490,17 @@ pub enum MisMode {
     Power,
     /// Next event estimation only for direct light; emitters hit by BSDF-sampled rays
     /// count only after specular bounces.
+    #[serde(rename = "none")]
     NeeOnly,
     /// BSDF sampling only: no shadow rays. For testing estimators against each other.
+    #[serde(rename = "bsdf")]
     BsdfOnly,
 }
 
-/// How to pick the one light that next event estimation samples.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+/// How to pick the one light that next event estimation samples. Its names in scene files
+/// and on the command line are the variants' names in kebab case (`ris-bvh`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Deserialize)]
+#[serde(rename_all = "kebab-case")]
 pub enum LightSamplerKind {
     Uniform,
     /// Proportional to emitted power, through an alias table.

@@ -142,34 +142,14 @@ pub(crate) fn item_type(
 }
 
 #[derive(Deserialize)]
-#[serde(rename_all = "snake_case")]
-enum MisName {
-    Balance,
-    Power,
-    None,
-    Bsdf,
-}
-
-#[derive(Deserialize)]
-#[serde(rename_all = "kebab-case")]
-enum LightSamplerName {
-    Uniform,
-    Power,
-    Array,
-    Ris,
-    Bvh,
-    RisBvh,
-}
-
-#[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
 struct RenderSection {
     resolution: Option<[u32; 2]>,
     spp: Option<u32>,
     max_depth: Option<u32>,
     seed: Option<u64>,
-    mis: Option<MisName>,
-    light_sampler: Option<LightSamplerName>,
+    mis: Option<MisMode>,
+    light_sampler: Option<LightSamplerKind>,
     ris_candidates: Option<std::num::NonZeroU32>,
 }
 
@@ -182,24 +162,8 @@ fn parse_render(src: &Source, value: Item) -> Result<RenderSettings, LoadError> 
     out.spp = r.spp.unwrap_or(out.spp);
     out.max_depth = r.max_depth.unwrap_or(out.max_depth);
     out.seed = r.seed.unwrap_or(out.seed);
-    if let Some(mis) = r.mis {
-        out.mis = match mis {
-            MisName::Balance => MisMode::Balance,
-            MisName::Power => MisMode::Power,
-            MisName::None => MisMode::NeeOnly,
-            MisName::Bsdf => MisMode::BsdfOnly,
-        };
-    }
-    if let Some(ls) = r.light_sampler {
-        out.light_sampler = match ls {
-            LightSamplerName::Uniform => LightSamplerKind::Uniform,
-            LightSamplerName::Power => LightSamplerKind::Power,
-            LightSamplerName::Array => LightSamplerKind::Array,
-            LightSamplerName::Ris => LightSamplerKind::Ris,
-            LightSamplerName::Bvh => LightSamplerKind::Bvh,
-            LightSamplerName::RisBvh => LightSamplerKind::RisBvh,
-        };
-    }
+    out.mis = r.mis.unwrap_or(out.mis);
+    out.light_sampler = r.light_sampler.unwrap_or(out.light_sampler);
     if let Some(n) = r.ris_candidates {
         out.ris_candidates = n.get();
     }
