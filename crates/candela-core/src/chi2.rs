@@ -527,8 +527,10 @@ fn chi2_core(
 }
 
 mod special;
+mod welch;
 
 pub use special::{chi2_survival, gamma_q, ln_gamma};
+pub use welch::{student_t_two_sided, welch_p, welch_p_samples};
 
 #[cfg(test)]
 mod tests;

@@ -1,13 +1,11 @@
 //! Rendered depth of field: the bokeh of a tiny out-of-focus emitter has the aperture's
 //! corners and the thin lens's circle-of-confusion size, and a scene lying in the plane of
 //! focus renders as the pinhole renders it (Welch test per pixel).
-
-mod common;
-
 use std::f32::consts::TAU;
 use std::sync::atomic::AtomicBool;
 
 use candela_core::build::build;
+use candela_core::chi2::welch_p;
 use candela_core::desc::*;
 use candela_core::integrator::render;
 use glam::{Mat4, Quat, Vec2, Vec3};
@@ -334,7 +332,7 @@ fn rejected_pixels(a: &[(f64, f64)], b: &[(f64, f64)], k: f64) -> usize {
     let alpha = 0.01 / a.len() as f64;
     a.iter()
         .zip(b)
-        .filter(|((ma, va), (mb, vb))| common::welch_p(*ma, *va, k, *mb, *vb, k) < alpha)
+        .filter(|((ma, va), (mb, vb))| welch_p(*ma, *va, k, *mb, *vb, k) < alpha)
         .count()
 }
 
