@@ -397,7 +397,8 @@ fn validate_lens(c: &CameraDesc, lens: &LensDesc) -> Result<(), BuildError> {
     Ok(())
 }
 
-fn build_texture(t: &TextureDesc, span: &Span, what: &str) -> Result<Texture, BuildError> {
+/// The render-time texture of a description, checked (`what` names it in errors).
+pub fn build_texture(t: &TextureDesc, span: &Span, what: &str) -> Result<Texture, BuildError> {
     match t {
         TextureDesc::Constant(c) => {
             check_color(span, what, *c)?;

@@ -533,6 +533,9 @@ pub struct RenderSettings {
     pub light_sampler: LightSamplerKind,
     /// Candidates per pick of the RIS light samplers.
     pub ris_candidates: u32,
+    /// Camera rays that hit an emitter or escape to the environment return nothing at
+    /// all, as with Mitsuba's `hide_emitters` (the emitters still light the scene).
+    pub hide_emitters: bool,
 }
 
 impl Default for RenderSettings {
@@ -546,6 +549,7 @@ impl Default for RenderSettings {
             mis: MisMode::default(),
             light_sampler: LightSamplerKind::default(),
             ris_candidates: DEFAULT_RIS_CANDIDATES,
+            hide_emitters: false,
         }
     }
 }

@@ -166,7 +166,14 @@ pub fn li<S: Sampler>(scene: &Scene, mut ray: Ray, sampler: &mut S, rays: &mut u
 
     loop {
         *rays += 1;
-        let Some(si) = scene.intersect(&ray, f32::INFINITY) else {
+        let hit = scene.intersect(&ray, f32::INFINITY);
+        if depth == 0
+            && scene.settings.hide_emitters
+            && hit.as_ref().is_none_or(|si| si.light.is_some())
+        {
+            break;
+        }
+        let Some(si) = hit else {
             for &id in &scene.infinite_lights {
                 let light = scene.light(id);
                 let le = if depth == 0 {

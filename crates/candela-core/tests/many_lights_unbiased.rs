@@ -23,6 +23,7 @@ fn scene(kind: LightSamplerKind, mis: MisMode, seed: u64) -> candela_core::Scene
             mis,
             light_sampler: kind,
             ris_candidates: 4,
+            ..Default::default()
         },
         ..Default::default()
     };

@@ -1,24 +1,14 @@
 //! `<bsdf>`: Mitsuba's BSDFs to Candela materials. Mitsuba's reflective BSDFs are
 //! one-sided (black from the back) unless wrapped in `twosided`; Candela's are two-sided,
-//! so an unwrapped one becomes [`BsdfDesc::OneSided`].
+//! so an unwrapped one becomes [`BsdfDesc::OneSided`]. Dielectrics are two-sided in both.
 
+use candela_core::bsdf::metal_preset;
 use candela_core::desc::{BsdfDesc, MaterialDesc, TextureDesc};
 use glam::Vec3;
 
 use super::parse::Node;
 use super::{describe, Ctx};
 use crate::LoadError;
-
-/// BSDFs that Candela will map once the materials work lands.
-const PLANNED: &[&str] = &[
-    "conductor",
-    "roughconductor",
-    "dielectric",
-    "roughdielectric",
-    "thindielectric",
-    "plastic",
-    "roughplastic",
-];
 
 /// Adds the material of a `<bsdf>` element and returns its name (its `id` if it has one).
 pub(crate) fn material(ctx: &mut Ctx, node: &Node) -> Result<String, LoadError> {
@@ -37,17 +27,25 @@ pub(crate) fn material(ctx: &mut Ctx, node: &Node) -> Result<String, LoadError> 
     Ok(name)
 }
 
-/// The grey one-sided diffuse that Mitsuba gives a shape without a BSDF.
-pub(crate) fn default_material(ctx: &mut Ctx) -> String {
-    const NAME: &str = "mitsuba-default-diffuse";
-    if !ctx.desc.materials.iter().any(|m| m.name == NAME) {
+/// The one-sided diffuse that Mitsuba gives a shape without a BSDF: grey (0.5), or black
+/// on an emitter (Mitsuba 3.9.1 renders an emitting square without a BSDF, lit by a
+/// constant sky, as its radiance alone).
+pub(crate) fn default_material(ctx: &mut Ctx, emitter: bool) -> String {
+    let (name, albedo) = if emitter {
+        ("mitsuba-default-emitter", 0.0)
+    } else {
+        ("mitsuba-default-diffuse", 0.5)
+    };
+    if !ctx.desc.materials.iter().any(|m| m.name == name) {
         ctx.desc.materials.push(MaterialDesc {
-            name: NAME.to_string(),
-            bsdf: BsdfDesc::OneSided(Box::new(grey())),
+            name: name.to_string(),
+            bsdf: BsdfDesc::OneSided(Box::new(BsdfDesc::Diffuse {
+                albedo: TextureDesc::Constant(Vec3::splat(albedo)),
+            })),
             span: candela_core::desc::Span::code(),
         });
     }
-    NAME.to_string()
+    name.to_string()
 }
 
 fn grey() -> BsdfDesc {
@@ -74,29 +72,211 @@ fn bsdf(ctx: &mut Ctx, node: &Node) -> Result<BsdfDesc, LoadError> {
         return Ok(d);
     }
     Ok(match two_sided(ctx, node)? {
-        BsdfDesc::Diffuse { albedo } => BsdfDesc::OneSided(Box::new(BsdfDesc::Diffuse { albedo })),
+        d @ (BsdfDesc::Diffuse { .. } | BsdfDesc::Conductor { .. } | BsdfDesc::Plastic { .. }) => {
+            BsdfDesc::OneSided(Box::new(d))
+        }
         other => other,
     })
 }
 
 /// The BSDF as Candela's (two-sided) material.
 fn two_sided(ctx: &mut Ctx, node: &Node) -> Result<BsdfDesc, LoadError> {
-    let d = match node.kind() {
+    let kind = node.kind();
+    let d = match kind {
         "diffuse" => BsdfDesc::Diffuse {
-            albedo: TextureDesc::Constant(ctx.color(node, "reflectance", Vec3::splat(0.5))?),
+            albedo: ctx.texture(node, "reflectance", Vec3::splat(0.5))?,
         },
+        "conductor" | "roughconductor" => {
+            let (eta, k) = conductor_ior(ctx, node)?;
+            let (alpha_u, alpha_v) = roughness(ctx, node, kind == "roughconductor")?;
+            unit_only(ctx, node, "specular_reflectance")?;
+            BsdfDesc::Conductor {
+                eta,
+                k,
+                alpha_u,
+                alpha_v,
+            }
+        }
+        "dielectric" | "roughdielectric" | "thindielectric" => {
+            let eta = ior(node, "int_ior", 1.5046)? / ior(node, "ext_ior", 1.000277)?;
+            let (alpha_u, alpha_v) = roughness(ctx, node, kind == "roughdielectric")?;
+            unit_only(ctx, node, "specular_reflectance")?;
+            unit_only(ctx, node, "specular_transmittance")?;
+            BsdfDesc::Dielectric {
+                eta,
+                alpha_u,
+                alpha_v,
+                thin: kind == "thindielectric",
+            }
+        }
+        "plastic" | "roughplastic" => {
+            let eta = ior(node, "int_ior", 1.49)? / ior(node, "ext_ior", 1.000277)?;
+            if kind == "roughplastic" {
+                roughness(ctx, node, true)?;
+                ctx.warn(
+                    node,
+                    "roughplastic: Candela's plastic has a smooth coat, so the highlight is \
+                     sharp where Mitsuba's is blurred by alpha",
+                );
+            }
+            unit_only(ctx, node, "specular_reflectance")?;
+            if node.boolean("nonlinear")? == Some(true) {
+                ctx.warn(
+                    node,
+                    "nonlinear=true is ignored: Candela's plastic is linear",
+                );
+            }
+            ctx.warn(
+                node,
+                "plastic: Candela's coat model (albedo 1 at reflectance 1) differs from \
+                 Mitsuba's in how much light the coat traps; diffuse tones differ slightly",
+            );
+            BsdfDesc::Plastic {
+                albedo: ctx.texture(node, "diffuse_reflectance", Vec3::splat(0.5))?,
+                eta,
+            }
+        }
         "twosided" => return Err(node.error("twosided inside twosided")),
-        k => {
-            let why = if PLANNED.contains(&k) {
-                "is not supported yet"
-            } else {
-                "is not supported"
-            };
-            ctx.unsupported(node, format!("<{}> {why}", describe(node)))?;
+        _ => {
+            ctx.unsupported(node, format!("<{}> is not supported", describe(node)))?;
             ctx.warn(node, "using a grey diffuse in its place");
             return Ok(grey());
         }
     };
     ctx.check_unused(node)?;
     Ok(d)
+}
+
+/// η and k of a conductor: a `material` preset (default `none`, an ideal mirror), or
+/// `eta` and `k` given directly.
+fn conductor_ior(ctx: &mut Ctx, node: &Node) -> Result<(Vec3, Vec3), LoadError> {
+    let material = node.string("material")?;
+    let (eta, k) = (node.color("eta")?, node.color("k")?);
+    match (material, eta, k) {
+        (Some(_), Some(_), _) | (Some(_), _, Some(_)) => {
+            Err(node.error("give a conductor's material or its eta and k, not both"))
+        }
+        (None, Some(eta), Some(k)) => Ok((eta, k)),
+        (None, Some(_), None) | (None, None, Some(_)) => {
+            Err(node.error("a conductor needs both eta and k"))
+        }
+        // η = 0, k = 1 reflects everything at every angle: Mitsuba's "none".
+        (Some("none"), None, None) | (None, None, None) => Ok((Vec3::ZERO, Vec3::ONE)),
+        (Some(name), None, None) => match metal_preset(name) {
+            Some(p) => Ok(p),
+            None => {
+                let p = node.prop("material").expect("read just now");
+                ctx.unsupported(
+                    p,
+                    format!(
+                        "conductor material \"{name}\" is not among Candela's presets \
+                         (Au, Ag, Cu, Al, Cr, none); give eta and k instead"
+                    ),
+                )?;
+                Ok((Vec3::ZERO, Vec3::ONE))
+            }
+        },
+    }
+}
+
+/// Mitsuba's named indices of refraction (its `ior.h`), for `int_ior` and `ext_ior`.
+const NAMED_IOR: &[(&str, f32)] = &[
+    ("vacuum", 1.0),
+    ("helium", 1.000036),
+    ("hydrogen", 1.000132),
+    ("air", 1.000277),
+    ("carbon dioxide", 1.00045),
+    ("water", 1.333),
+    ("acetone", 1.36),
+    ("ethanol", 1.361),
+    ("carbon tetrachloride", 1.461),
+    ("glycerol", 1.4729),
+    ("benzene", 1.501),
+    ("silicone oil", 1.52045),
+    ("bromine", 1.661),
+    ("water ice", 1.31),
+    ("fused quartz", 1.458),
+    ("pyrex", 1.47),
+    ("acrylic glass", 1.49),
+    ("polypropylene", 1.49),
+    ("bk7", 1.5046),
+    ("sodium chloride", 1.544),
+    ("amber", 1.55),
+    ("pet", 1.575),
+    ("diamond", 2.419),
+];
+
+/// An index of refraction given as a number or by one of Mitsuba's names.
+fn ior(node: &Node, name: &str, default: f32) -> Result<f32, LoadError> {
+    let Some(p) = node.prop(name) else {
+        return Ok(default);
+    };
+    let v = p.req("value")?;
+    let ior = match p.tag.as_str() {
+        "float" => p.parse_f32(v)?,
+        "string" => NAMED_IOR
+            .iter()
+            .find(|(n, _)| n.eq_ignore_ascii_case(v))
+            .map(|&(_, x)| x)
+            .ok_or_else(|| p.error(format!("unknown index of refraction \"{v}\"")))?,
+        t => {
+            return Err(p.error(format!(
+                "\"{name}\" must be a <float> or a <string> material name, not <{t}>"
+            )))
+        }
+    };
+    if ior <= 0.0 {
+        return Err(p.error(format!("\"{name}\" must be positive, got {ior}")));
+    }
+    Ok(ior)
+}
+
+/// GGX α along u and v: `alpha` (default 0.1, as Mitsuba), or `alpha_u` and `alpha_v`;
+/// zero for the smooth variants.
+fn roughness(ctx: &mut Ctx, node: &Node, rough: bool) -> Result<(f32, f32), LoadError> {
+    if !rough {
+        return Ok((0.0, 0.0));
+    }
+    if let Some(d) = node.string("distribution")? {
+        match d {
+            "ggx" => {}
+            "beckmann" => ctx.warn(
+                node,
+                "Candela's microfacets are GGX: the beckmann distribution is rendered as \
+                 GGX of the same alpha",
+            ),
+            _ => {
+                let p = node.prop("distribution").expect("read just now");
+                return Err(p.error(format!(
+                    "unknown microfacet distribution \"{d}\" (ggx or beckmann)"
+                )));
+            }
+        }
+    }
+    // Candela always samples visible normals; the flag changes noise, not the image.
+    node.boolean("sample_visible")?;
+    let alpha = node.float("alpha")?;
+    let (u, v) = (node.float("alpha_u")?, node.float("alpha_v")?);
+    Ok(match (alpha, u, v) {
+        (Some(a), None, None) => (a, a),
+        (None, Some(u), Some(v)) => (u, v),
+        (None, None, None) => (0.1, 0.1),
+        _ => return Err(node.error("give alpha, or both alpha_u and alpha_v")),
+    })
+}
+
+/// A colour Candela's BSDF cannot scale by: accepted only where it is 1 (the default).
+fn unit_only(ctx: &mut Ctx, node: &Node, name: &str) -> Result<(), LoadError> {
+    if let Some(p) = node.prop(name) {
+        if p.tag == "texture" || node.color(name)? != Some(Vec3::ONE) {
+            ctx.unsupported(
+                p,
+                format!(
+                    "\"{name}\" other than 1 is not supported in {}",
+                    describe(node)
+                ),
+            )?;
+        }
+    }
+    Ok(())
 }

@@ -1,44 +1,135 @@
 //! Top-level `<emitter>`s. Area emitters live inside shapes (see `shapes.rs`).
 
-use candela_core::desc::{LightDesc, LightKindDesc};
-use glam::Vec3;
+use std::f32::consts::PI;
+
+use candela_core::desc::{
+    DirectionalLightDesc, EnvironmentDesc, EnvironmentMapDesc, LightAmountDesc, LightColorDesc,
+    LightDesc, LightKindDesc, SpotFalloff, SpotLightDesc,
+};
+use glam::{Mat3, Mat4, Vec3};
 
 use super::parse::Node;
 use super::{describe, transform, Ctx};
+use crate::environment::load_linear_image;
 use crate::LoadError;
 
-/// Emitters that Candela will map once the spot, directional and environment work lands.
-const PLANNED: &[&str] = &["spot", "directional", "envmap", "constant"];
-
 pub(crate) fn emitter(ctx: &mut Ctx, node: &Node) -> Result<(), LoadError> {
-    match node.kind() {
+    let kind = match node.kind() {
         "point" => {
-            let from_position = node.point("position")?;
-            let from_transform = match node.prop("to_world") {
-                Some(t) => Some(transform::transform(t)?.transform_point3(Vec3::ZERO)),
-                None => None,
-            };
-            let position = match (from_position, from_transform) {
+            let position = placed(node, "position", Vec3::ZERO)?;
+            LightKindDesc::Point {
+                position,
+                intensity: node.color("intensity")?.unwrap_or(Vec3::ONE),
+            }
+        }
+        "spot" => {
+            // Mitsuba's spot shines along its local +z, falling off linearly in angle
+            // from `beam_width` to `cutoff_angle` (its `spot.cpp`).
+            let to_world = to_world(node)?;
+            let outer = node.float("cutoff_angle")?.unwrap_or(20.0);
+            let inner = node.float("beam_width")?.unwrap_or(outer * 0.75);
+            if !(0.0 < inner && inner <= outer && outer <= 180.0) {
+                return Err(node.error(format!(
+                    "spot needs 0 < beam_width ≤ cutoff_angle ≤ 180, got {inner} and {outer}"
+                )));
+            }
+            LightKindDesc::Spot(SpotLightDesc {
+                position: to_world.transform_point3(Vec3::ZERO),
+                direction: to_world.transform_vector3(Vec3::Z),
+                inner_angle_deg: inner,
+                outer_angle_deg: outer,
+                falloff: SpotFalloff::Mitsuba,
+                color: LightColorDesc::Rgb(node.color("intensity")?.unwrap_or(Vec3::ONE)),
+                amount: LightAmountDesc::WattsPerSr(1.0),
+                profile: None,
+            })
+        }
+        "directional" => {
+            // `direction` is where the light goes; `to_world` sends it along local +z.
+            let direction = match (node.point("direction")?, node.prop("to_world")) {
                 (Some(_), Some(_)) => {
-                    return Err(node.error("point emitter: give position or to_world, not both"))
+                    return Err(node.error("directional: give direction or to_world, not both"))
                 }
-                (p, t) => p.or(t).unwrap_or(Vec3::ZERO),
+                (Some(d), None) => d,
+                (None, _) => to_world(node)?.transform_vector3(Vec3::Z),
             };
-            let intensity = ctx.color(node, "intensity", Vec3::ONE)?;
-            ctx.check_unused(node)?;
-            ctx.desc.lights.push(LightDesc {
-                kind: LightKindDesc::Point {
-                    position,
-                    intensity,
-                },
-                span: node.span.clone(),
-            });
-            Ok(())
+            LightKindDesc::Directional(DirectionalLightDesc {
+                direction,
+                // An irradiance (W/m²) on a surface facing the light, per channel.
+                color: LightColorDesc::Rgb(node.color("irradiance")?.unwrap_or(Vec3::ONE)),
+                amount: LightAmountDesc::WattsPerSr(1.0),
+            })
         }
-        "area" => Err(node.error("an area emitter must sit inside a <shape>")),
-        k if PLANNED.contains(&k) => {
-            ctx.unsupported(node, format!("<{}> is not supported yet", describe(node)))
+        "envmap" | "constant" => return environment(ctx, node),
+        "area" => return Err(node.error("an area emitter must sit inside a <shape>")),
+        _ => return ctx.unsupported(node, format!("<{}> is not supported", describe(node))),
+    };
+    ctx.check_unused(node)?;
+    ctx.desc.lights.push(LightDesc {
+        kind,
+        span: node.span.clone(),
+    });
+    Ok(())
+}
+
+/// `envmap` and `constant`: Candela's environment.
+fn environment(ctx: &mut Ctx, node: &Node) -> Result<(), LoadError> {
+    if ctx.desc.environment.is_some() {
+        return Err(node.error("a scene has at most one envmap or constant emitter"));
+    }
+    let env = if node.kind() == "constant" {
+        EnvironmentDesc {
+            map: EnvironmentMapDesc::Constant(node.color("radiance")?.unwrap_or(Vec3::ONE)),
+            span: node.span.clone(),
+            ..EnvironmentDesc::default()
         }
-        _ => ctx.unsupported(node, format!("<{}> is not supported", describe(node))),
+    } else {
+        let file = node
+            .string("filename")?
+            .ok_or_else(|| node.error("an envmap needs a filename"))?;
+        let file_node = node.prop("filename").expect("read just now");
+        let image = load_linear_image(&ctx.base.join(file))
+            .map_err(|e| file_node.error(format!("cannot load \"{file}\": {e}")))?;
+        let to_world = Mat3::from_mat4(to_world(node)?);
+        if (to_world.determinant() - 1.0).abs() > 1e-3 {
+            return Err(node.error("an envmap's to_world must be a rotation"));
+        }
+        EnvironmentDesc {
+            map: EnvironmentMapDesc::Equirect(image),
+            strength: node.float("scale")?.unwrap_or(1.0),
+            rotation: to_world * mitsuba_envmap_frame(),
+            span: node.span.clone(),
+            ..EnvironmentDesc::default()
+        }
+    };
+    ctx.check_unused(node)?;
+    ctx.desc.environment = Some(env);
+    Ok(())
+}
+
+/// Candela's equirect map frame as seen from Mitsuba's. Both put the image's v along
+/// acos(y); Mitsuba's u is atan2(x, −z)/2π, so −z is the image's left edge, while
+/// Candela's u is (1 + atan2(x, −z)/π)/2, with −z at the centre. The image turned by half
+/// a turn about y lands where Mitsuba puts it.
+pub(crate) fn mitsuba_envmap_frame() -> Mat3 {
+    Mat3::from_rotation_y(PI)
+}
+
+/// A plugin's `to_world` transform (identity when absent).
+fn to_world(node: &Node) -> Result<Mat4, LoadError> {
+    match node.prop("to_world") {
+        Some(t) if t.tag == "transform" => transform::transform(t),
+        Some(t) => Err(t.error("to_world must be a <transform>")),
+        None => Ok(Mat4::IDENTITY),
+    }
+}
+
+/// A position given as the point property `name` or as `to_world`'s origin.
+fn placed(node: &Node, name: &str, default: Vec3) -> Result<Vec3, LoadError> {
+    match (node.point(name)?, node.prop("to_world")) {
+        (Some(_), Some(_)) => Err(node.error(format!("give {name} or to_world, not both"))),
+        (Some(p), None) => Ok(p),
+        (None, Some(_)) => Ok(to_world(node)?.transform_point3(Vec3::ZERO)),
+        (None, None) => Ok(default),
     }
 }

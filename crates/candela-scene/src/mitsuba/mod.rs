@@ -10,12 +10,13 @@ mod emitters;
 mod parse;
 mod sensor;
 mod shapes;
+mod textures;
 mod transform;
 
 use std::collections::HashMap;
 use std::path::Path;
 
-use candela_core::desc::SceneDesc;
+use candela_core::desc::{SceneDesc, TextureDesc};
 use glam::Vec3;
 
 use crate::{LoadError, LoadOptions, LoadedScene};
@@ -31,10 +32,23 @@ pub fn load_mitsuba(path: &Path, options: &LoadOptions) -> Result<LoadedScene, L
         base: path.parent().unwrap_or(Path::new("")).to_path_buf(),
         warnings: Vec::new(),
         bsdf_ids: HashMap::new(),
+        texture_ids: HashMap::new(),
         desc: SceneDesc::default(),
     };
     // Mitsuba's default integrator is `path` with unlimited depth.
     ctx.desc.render.max_depth = candela_max_depth(-1).expect("-1 is valid");
+    // Named textures, then named BSDFs, so that shapes may refer to them wherever they
+    // are defined.
+    for c in root.children.iter().filter(|c| c.tag == "texture") {
+        c.used.set(true);
+        let Some(id) = c.attr("id") else {
+            return Err(c.error("a top-level <texture> needs an id"));
+        };
+        let tex = textures::texture(&mut ctx, c)?;
+        if ctx.texture_ids.insert(id.to_string(), tex).is_some() {
+            return Err(c.error(format!("id \"{id}\" is used twice")));
+        }
+    }
     // Named BSDFs first, so that shapes may refer to them wherever they are defined.
     for c in root.children.iter().filter(|c| c.tag == "bsdf") {
         c.used.set(true);
@@ -45,7 +59,7 @@ pub fn load_mitsuba(path: &Path, options: &LoadOptions) -> Result<LoadedScene, L
     }
     for c in &root.children {
         match c.tag.as_str() {
-            "bsdf" => {}
+            "bsdf" | "texture" => {}
             "shape" => shapes::shape(&mut ctx, c)?,
             "emitter" => emitters::emitter(&mut ctx, c)?,
             "sensor" => sensor::sensor(&mut ctx, c)?,
@@ -68,6 +82,8 @@ pub(crate) struct Ctx {
     pub warnings: Vec<String>,
     /// Material name of each BSDF `id`.
     pub bsdf_ids: HashMap<String, String>,
+    /// Each top-level texture by its `id`.
+    pub texture_ids: HashMap<String, TextureDesc>,
     pub desc: SceneDesc,
 }
 
@@ -102,25 +118,30 @@ impl Ctx {
         Ok(())
     }
 
-    /// A colour property, or `default` when it is absent; a texture in its place (not
-    /// supported yet) is an error, or under `lenient` a warning and `default`.
-    pub fn color(&mut self, node: &Node, name: &str, default: Vec3) -> Result<Vec3, LoadError> {
-        match node
+    /// A texturable property: a nested `<texture>`, a `<ref>` to a top-level one, or a
+    /// colour; `default` when it is absent.
+    pub fn texture(
+        &mut self,
+        node: &Node,
+        name: &str,
+        default: Vec3,
+    ) -> Result<TextureDesc, LoadError> {
+        if let Some(r) = node
             .children
             .iter()
-            .find(|c| c.tag == "texture" && c.name() == name)
+            .find(|c| c.tag == "ref" && c.name() == name)
         {
-            Some(t) => {
-                self.unsupported(
-                    t,
-                    format!(
-                        "<texture type=\"{}\"> as \"{name}\" is not supported yet",
-                        t.kind()
-                    ),
-                )?;
-                Ok(default)
-            }
-            None => Ok(node.color(name)?.unwrap_or(default)),
+            r.used.set(true);
+            let id = r.req("id")?;
+            return self
+                .texture_ids
+                .get(id)
+                .cloned()
+                .ok_or_else(|| r.error(format!("no texture has the id \"{id}\"")));
+        }
+        match node.prop(name) {
+            Some(t) if t.tag == "texture" => textures::texture(self, t),
+            _ => Ok(TextureDesc::Constant(node.color(name)?.unwrap_or(default))),
         }
     }
 

@@ -123,8 +123,7 @@ impl Node {
                 Ok(Some(Vec3::splat(p.parse_f32(v)?)))
             }
             "texture" => Err(p.error(format!(
-                "texture \"{}\" as \"{name}\" is not supported yet",
-                p.kind()
+                "\"{name}\" must be a constant colour here, not a <texture>"
             ))),
             other => Err(p.error(format!("\"{name}\" must be a colour, not <{other}>"))),
         }

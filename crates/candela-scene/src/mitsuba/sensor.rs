@@ -51,10 +51,7 @@ pub(crate) fn integrator(ctx: &mut Ctx, node: &Node) -> Result<(), LoadError> {
             );
         }
     }
-    if node.boolean("hide_emitters")? == Some(true) {
-        let p = node.prop("hide_emitters").expect("read just now");
-        ctx.unsupported(p, "hide_emitters=true is not supported yet".into())?;
-    }
+    ctx.desc.render.hide_emitters = node.boolean("hide_emitters")?.unwrap_or(false);
     ctx.check_unused(node)
 }
 

@@ -61,7 +61,7 @@ pub(crate) fn shape(ctx: &mut Ctx, node: &Node) -> Result<(), LoadError> {
         if emission.is_some() {
             return Err(e.error("a shape has at most one area emitter"));
         }
-        emission = Some(ctx.color(e, "radiance", Vec3::ONE)?);
+        emission = Some(e.color("radiance")?.unwrap_or(Vec3::ONE));
         ctx.check_unused(e)?;
     }
     ctx.check_unused(node)?;
@@ -76,7 +76,8 @@ pub(crate) fn shape(ctx: &mut Ctx, node: &Node) -> Result<(), LoadError> {
     Ok(())
 }
 
-/// The shape's material: an inline `<bsdf>`, a `<ref id>` to one, or Mitsuba's default.
+/// The shape's material: an inline `<bsdf>`, a `<ref id>` to one, or Mitsuba's default
+/// (grey diffuse; black for an emitter, which then only emits).
 fn material(ctx: &mut Ctx, node: &Node) -> Result<String, LoadError> {
     let mut found: Option<String> = None;
     for c in &node.children {
@@ -97,5 +98,6 @@ fn material(ctx: &mut Ctx, node: &Node) -> Result<String, LoadError> {
         }
         found = Some(name);
     }
-    Ok(found.unwrap_or_else(|| bsdfs::default_material(ctx)))
+    let emits = node.children.iter().any(|c| c.tag == "emitter");
+    Ok(found.unwrap_or_else(|| bsdfs::default_material(ctx, emits)))
 }

@@ -1,0 +1,504 @@
+//! Mitsuba XML import of BSDFs, textures, emitters and `hide_emitters`. Where Mitsuba's
+//! behaviour is not plain from its documentation, the expected numbers were computed once
+//! with Mitsuba 3.9.1 (`mitsuba` from PyPI, `scalar_rgb`); the script is quoted.
+
+use std::sync::atomic::AtomicBool;
+
+use candela_core::build::{build, build_texture};
+use candela_core::desc::*;
+use candela_core::geometry::Ray;
+use candela_scene::{load_scene_with, LoadOptions, LoadedScene};
+use glam::{Vec2, Vec3};
+
+/// Writes `files` (name, bytes) into a fresh folder and loads the first.
+fn load_files(files: &[(&str, &[u8])], lenient: bool) -> Result<LoadedScene, String> {
+    let dir = tempfile::tempdir().unwrap();
+    for (name, bytes) in files {
+        std::fs::write(dir.path().join(name), bytes).unwrap();
+    }
+    let options = LoadOptions {
+        lenient,
+        ..Default::default()
+    };
+    load_scene_with(&dir.path().join(files[0].0), &options).map_err(|e| e.to_string())
+}
+
+fn scene(body: &str) -> String {
+    format!("<scene version=\"3.0.0\">\n{body}\n</scene>")
+}
+
+fn load(body: &str) -> LoadedScene {
+    load_files(&[("scene.xml", scene(body).as_bytes())], false).unwrap_or_else(|e| panic!("{e}"))
+}
+
+fn load_err(body: &str) -> String {
+    let e = load_files(&[("scene.xml", scene(body).as_bytes())], false).expect_err("should fail");
+    assert!(e.contains("scene.xml:"), "{e}");
+    e
+}
+
+/// The BSDF of the only material.
+fn bsdf(body: &str) -> BsdfDesc {
+    let desc = load(&format!("<shape type=\"cube\">{body}</shape>")).desc;
+    desc.materials[0].bsdf.clone()
+}
+
+fn assert_close(a: Vec3, b: Vec3, tol: f32) {
+    assert!((a - b).abs().max_element() < tol, "{a} vs {b}");
+}
+
+#[test]
+fn conductors_take_presets_or_eta_and_k_and_are_one_sided() {
+    let (au_eta, au_k) = candela_core::bsdf::metal_preset("Au").unwrap();
+    match bsdf(r#"<bsdf type="conductor"><string name="material" value="Au"/></bsdf>"#) {
+        BsdfDesc::OneSided(inner) => match *inner {
+            BsdfDesc::Conductor {
+                eta,
+                k,
+                alpha_u,
+                alpha_v,
+            } => {
+                assert_eq!((eta, k, alpha_u, alpha_v), (au_eta, au_k, 0.0, 0.0));
+            }
+            other => panic!("{other:?}"),
+        },
+        other => panic!("{other:?}"),
+    }
+    // Mitsuba's default material "none" reflects everything: η = 0, k = 1.
+    match bsdf(r#"<bsdf type="twosided"><bsdf type="conductor"/></bsdf>"#) {
+        BsdfDesc::Conductor { eta, k, .. } => assert_eq!((eta, k), (Vec3::ZERO, Vec3::ONE)),
+        other => panic!("twosided is not one-sided: {other:?}"),
+    }
+    let rough = r#"<bsdf type="twosided"><bsdf type="roughconductor">
+        <rgb name="eta" value="0.2, 0.9, 1.1"/><rgb name="k" value="3.9, 2.4, 1.6"/>
+        <float name="alpha_u" value="0.05"/><float name="alpha_v" value="0.3"/>
+        <string name="distribution" value="ggx"/></bsdf></bsdf>"#;
+    match bsdf(rough) {
+        BsdfDesc::Conductor {
+            eta,
+            k,
+            alpha_u,
+            alpha_v,
+        } => {
+            assert_eq!(eta, Vec3::new(0.2, 0.9, 1.1));
+            assert_eq!(k, Vec3::new(3.9, 2.4, 1.6));
+            assert_eq!((alpha_u, alpha_v), (0.05, 0.3));
+        }
+        other => panic!("{other:?}"),
+    }
+    // Mitsuba's default roughness is α = 0.1.
+    match bsdf(r#"<bsdf type="twosided"><bsdf type="roughconductor"/></bsdf>"#) {
+        BsdfDesc::Conductor {
+            alpha_u, alpha_v, ..
+        } => assert_eq!((alpha_u, alpha_v), (0.1, 0.1)),
+        other => panic!("{other:?}"),
+    }
+    // Beckmann is rendered as GGX, with a warning saying so.
+    let loaded = load(
+        r#"<shape type="cube"><bsdf type="roughconductor">
+           <string name="distribution" value="beckmann"/></bsdf></shape>"#,
+    );
+    assert!(
+        loaded.warnings.iter().any(|w| w.contains("beckmann")),
+        "{:?}",
+        loaded.warnings
+    );
+    for (body, what) in [
+        (
+            r#"<bsdf type="conductor"><string name="material" value="W"/></bsdf>"#,
+            "\"W\" is not among",
+        ),
+        (
+            r#"<bsdf type="conductor"><rgb name="eta" value="1"/></bsdf>"#,
+            "both eta and k",
+        ),
+        (
+            r#"<bsdf type="roughconductor"><float name="alpha_u" value="0.1"/></bsdf>"#,
+            "alpha_u and alpha_v",
+        ),
+        (
+            r#"<bsdf type="roughconductor"><string name="distribution" value="phong"/></bsdf>"#,
+            "phong",
+        ),
+        (
+            r#"<bsdf type="conductor"><rgb name="specular_reflectance" value="0.5"/></bsdf>"#,
+            "specular_reflectance",
+        ),
+    ] {
+        let e = load_err(&format!("<shape type=\"cube\">{body}</shape>"));
+        assert!(e.contains(what), "{e}");
+    }
+}
+
+#[test]
+fn dielectrics_read_numbers_and_named_indices() {
+    match bsdf(r#"<bsdf type="dielectric"/>"#) {
+        // Mitsuba's defaults: BK7 inside (1.5046), air outside (1.000277).
+        BsdfDesc::Dielectric {
+            eta, alpha_u, thin, ..
+        } => {
+            assert!((eta - 1.5046 / 1.000277).abs() < 1e-6);
+            assert_eq!((alpha_u, thin), (0.0, false));
+        }
+        other => panic!("{other:?}"),
+    }
+    let water_in_glass = r#"<bsdf type="roughdielectric"><string name="int_ior" value="water"/>
+        <float name="ext_ior" value="1.5"/><float name="alpha" value="0.2"/></bsdf>"#;
+    match bsdf(water_in_glass) {
+        BsdfDesc::Dielectric {
+            eta,
+            alpha_u,
+            alpha_v,
+            thin,
+        } => {
+            assert!((eta - 1.333 / 1.5).abs() < 1e-6);
+            assert_eq!((alpha_u, alpha_v, thin), (0.2, 0.2, false));
+        }
+        other => panic!("{other:?}"),
+    }
+    match bsdf(r#"<bsdf type="thindielectric"><string name="int_ior" value="diamond"/></bsdf>"#) {
+        BsdfDesc::Dielectric { eta, thin, .. } => {
+            assert!((eta - 2.419 / 1.000277).abs() < 1e-6);
+            assert!(thin);
+        }
+        other => panic!("{other:?}"),
+    }
+    for (body, what) in [
+        (
+            r#"<bsdf type="dielectric"><string name="int_ior" value="unobtainium"/></bsdf>"#,
+            "unobtainium",
+        ),
+        (
+            r#"<bsdf type="dielectric"><float name="int_ior" value="-1"/></bsdf>"#,
+            "positive",
+        ),
+        (
+            r#"<bsdf type="dielectric"><rgb name="specular_transmittance" value="0.5"/></bsdf>"#,
+            "specular_transmittance",
+        ),
+    ] {
+        let e = load_err(&format!("<shape type=\"cube\">{body}</shape>"));
+        assert!(e.contains(what), "{e}");
+    }
+}
+
+#[test]
+fn plastics_become_candelas_plastic_with_warnings_on_what_differs() {
+    let loaded = load(
+        r#"<shape type="cube"><bsdf type="roughplastic">
+           <rgb name="diffuse_reflectance" value="0.1, 0.2, 0.3"/>
+           <float name="int_ior" value="1.6"/><float name="alpha" value="0.3"/></bsdf></shape>"#,
+    );
+    match &loaded.desc.materials[0].bsdf {
+        BsdfDesc::OneSided(inner) => match inner.as_ref() {
+            BsdfDesc::Plastic {
+                albedo: TextureDesc::Constant(c),
+                eta,
+            } => {
+                assert_eq!(*c, Vec3::new(0.1, 0.2, 0.3));
+                assert!((eta - 1.6 / 1.000277).abs() < 1e-6);
+            }
+            other => panic!("{other:?}"),
+        },
+        other => panic!("{other:?}"),
+    }
+    let w = loaded.warnings.join("\n");
+    assert!(
+        w.contains("smooth coat") && w.contains("scene.xml:2:"),
+        "{w}"
+    );
+}
+
+/// A 2 × 2 8-bit RGB PNG: top row red, green; bottom row blue, white, each channel at 128.
+fn png_2x2() -> Vec<u8> {
+    let mut img = image::RgbImage::new(2, 2);
+    img.put_pixel(0, 0, image::Rgb([128, 0, 0]));
+    img.put_pixel(1, 0, image::Rgb([0, 128, 0]));
+    img.put_pixel(0, 1, image::Rgb([0, 0, 128]));
+    img.put_pixel(1, 1, image::Rgb([128, 128, 128]));
+    let mut bytes = std::io::Cursor::new(Vec::new());
+    img.write_to(&mut bytes, image::ImageFormat::Png).unwrap();
+    bytes.into_inner()
+}
+
+fn albedo(desc: &SceneDesc) -> candela_core::texture::Texture {
+    let BsdfDesc::OneSided(inner) = &desc.materials[0].bsdf else {
+        panic!("{:?}", desc.materials[0].bsdf)
+    };
+    let BsdfDesc::Diffuse { albedo } = inner.as_ref() else {
+        panic!("{inner:?}")
+    };
+    build_texture(albedo, &Span::code(), "albedo").unwrap()
+}
+
+#[test]
+fn bitmaps_are_looked_up_as_mitsuba_does() {
+    let png = png_2x2();
+    let xml = |extra: &str| {
+        scene(&format!(
+            r#"<shape type="cube"><bsdf type="diffuse">
+               <texture type="bitmap" name="reflectance"><string name="filename" value="t.png"/>{extra}</texture>
+               </bsdf></shape>"#
+        ))
+    };
+    let load_tex = |extra: &str| {
+        let x = xml(extra);
+        let loaded = load_files(&[("scene.xml", x.as_bytes()), ("t.png", &png)], false)
+            .unwrap_or_else(|e| panic!("{e}"));
+        albedo(&loaded.desc)
+    };
+    // Mitsuba's uv (0, 0) is the image's top-left texel: red. sRGB 128 is 0.2158 linear.
+    let srgb_128 = 0.215_861;
+    let t = load_tex("");
+    assert_close(
+        t.eval(Vec2::new(0.25, 0.25)),
+        Vec3::new(srgb_128, 0.0, 0.0),
+        1e-4,
+    );
+    assert_close(
+        t.eval(Vec2::new(0.75, 0.25)),
+        Vec3::new(0.0, srgb_128, 0.0),
+        1e-4,
+    );
+    assert_close(
+        t.eval(Vec2::new(0.25, 0.75)),
+        Vec3::new(0.0, 0.0, srgb_128),
+        1e-4,
+    );
+    // `raw` keeps the stored values: 128/255.
+    let t = load_tex(r#"<boolean name="raw" value="true"/>"#);
+    assert_close(
+        t.eval(Vec2::new(0.75, 0.75)),
+        Vec3::splat(128.0 / 255.0),
+        1e-4,
+    );
+    // to_uv scales before the lookup: u = 0.25 · 3 = 0.75 lands on the green texel.
+    let t = load_tex(r#"<transform name="to_uv"><scale x="3" y="1"/></transform>"#);
+    assert_close(
+        t.eval(Vec2::new(0.25, 0.25)),
+        Vec3::new(0.0, srgb_128, 0.0),
+        1e-4,
+    );
+    // Clamping keeps the edge texel beyond the image; repeating wraps around.
+    let t = load_tex(r#"<string name="wrap_mode" value="clamp"/>"#);
+    assert_close(
+        t.eval(Vec2::new(1.75, 0.25)),
+        Vec3::new(0.0, srgb_128, 0.0),
+        1e-4,
+    );
+    let t = load_tex("");
+    assert_close(
+        t.eval(Vec2::new(1.25, 0.25)),
+        Vec3::new(srgb_128, 0.0, 0.0),
+        1e-4,
+    );
+    let x = xml(r#"<string name="wrap_mode" value="spiral"/>"#);
+    let e = load_files(&[("scene.xml", x.as_bytes()), ("t.png", &png)], false).unwrap_err();
+    assert!(e.contains("spiral") && e.contains("scene.xml:3:"), "{e}");
+    let e = load_files(&[("scene.xml", xml("").as_bytes())], false).unwrap_err();
+    assert!(e.contains("t.png"), "{e}");
+}
+
+#[test]
+fn checkerboards_and_texture_references() {
+    // Mitsuba's checkerboard: colour0 where the fractional parts of u and v are on the
+    // same side of ½ (its `checkerboard.cpp`); defaults 0.4 and 0.2.
+    let loaded = load(
+        r#"<texture type="checkerboard" id="checks"><rgb name="color1" value="0.9, 0.1, 0.1"/></texture>
+           <shape type="cube"><bsdf type="diffuse"><ref name="reflectance" id="checks"/></bsdf></shape>"#,
+    );
+    let t = albedo(&loaded.desc);
+    let (c0, c1) = (Vec3::splat(0.4), Vec3::new(0.9, 0.1, 0.1));
+    for (uv, c) in [
+        ((0.25, 0.25), c0),
+        ((0.75, 0.75), c0),
+        ((0.75, 0.25), c1),
+        ((0.25, 0.75), c1),
+        ((1.25, 0.25), c0),
+        ((-0.25, 0.25), c1),
+    ] {
+        assert_eq!(t.eval(Vec2::new(uv.0, uv.1)), c, "at {uv:?}");
+    }
+    let e = load_err(
+        r#"<shape type="cube"><bsdf type="diffuse"><ref name="reflectance" id="nope"/></bsdf></shape>"#,
+    );
+    assert!(e.contains("nope"), "{e}");
+    let e = load_err(r#"<texture type="checkerboard"/>"#);
+    assert!(e.contains("needs an id"), "{e}");
+}
+
+/// The one light of a scene.
+fn light(body: &str) -> LightKindDesc {
+    let desc = load(body).desc;
+    assert_eq!(desc.lights.len(), 1);
+    desc.lights[0].kind.clone()
+}
+
+#[test]
+fn spot_and_directional_emitters_map_with_mitsubas_defaults() {
+    let spot = light(
+        r#"<emitter type="spot"><rgb name="intensity" value="2, 3, 4"/>
+           <float name="cutoff_angle" value="30"/>
+           <transform name="to_world"><lookat origin="1, 2, 3" target="1, 2, 2" up="0, 1, 0"/></transform>
+           </emitter>"#,
+    );
+    match spot {
+        LightKindDesc::Spot(s) => {
+            assert_close(s.position, Vec3::new(1.0, 2.0, 3.0), 1e-6);
+            assert_close(s.direction, Vec3::new(0.0, 0.0, -1.0), 1e-6);
+            // beam_width defaults to ¾ of the cutoff angle.
+            assert_eq!((s.inner_angle_deg, s.outer_angle_deg), (22.5, 30.0));
+            assert_eq!(s.falloff, SpotFalloff::Mitsuba);
+            assert_eq!(s.color, LightColorDesc::Rgb(Vec3::new(2.0, 3.0, 4.0)));
+            assert_eq!(s.amount, LightAmountDesc::WattsPerSr(1.0));
+        }
+        other => panic!("{other:?}"),
+    }
+    let e = load_err(
+        r#"<emitter type="spot"><float name="cutoff_angle" value="10"/><float name="beam_width" value="20"/></emitter>"#,
+    );
+    assert!(e.contains("beam_width"), "{e}");
+    match light(
+        r#"<emitter type="directional"><vector name="direction" value="0, -1, 0"/>
+           <rgb name="irradiance" value="5"/></emitter>"#,
+    ) {
+        LightKindDesc::Directional(d) => {
+            assert_eq!(d.direction, Vec3::NEG_Y);
+            assert_eq!(d.color, LightColorDesc::Rgb(Vec3::splat(5.0)));
+            assert_eq!(d.amount, LightAmountDesc::WattsPerSr(1.0));
+        }
+        other => panic!("{other:?}"),
+    }
+    // Without a direction, to_world sends the light along its local +z.
+    match light(
+        r#"<emitter type="directional"><transform name="to_world"><rotate x="1" angle="90"/></transform></emitter>"#,
+    ) {
+        LightKindDesc::Directional(d) => assert_close(d.direction, Vec3::NEG_Y, 1e-6),
+        other => panic!("{other:?}"),
+    }
+}
+
+/// An 8 × 4 EXR whose texel (i, j) is (i + 1, j + 1, 1).
+fn exr_8x4(path: &std::path::Path) {
+    exr::prelude::write_rgb_file(path, 8, 4, |i, j| ((i + 1) as f32, (j + 1) as f32, 1.0f32))
+        .unwrap();
+}
+
+#[test]
+fn envmaps_face_where_mitsuba_faces_them() {
+    // Reference values from Mitsuba 3.9.1 (scalar_rgb), the same 8 × 4 map:
+    //   s = mi.load_dict({'type': 'scene', 'env': {'type': 'envmap', 'filename': 'env.exr',
+    //        'to_world': mi.ScalarTransform4f.rotate([0, 1, 0], rot)}})
+    //   si = mi.SurfaceInteraction3f(); si.wi = -d; s.emitters()[0].eval(si)
+    // On the horizon Mitsuba and Candela both give the mean of rows 1 and 2 in green
+    // (2.5); red tells the longitude.
+    let expected = [
+        (0.0, Vec3::new(0.0, 0.0, -1.0), 4.5),
+        (0.0, Vec3::new(1.0, 0.0, 0.0), 2.5),
+        (0.0, Vec3::new(0.0, 0.0, 1.0), 4.5),
+        (0.0, Vec3::new(-1.0, 0.0, 0.0), 6.5),
+        (0.0, Vec3::new(0.6, 0.0, -0.8), 1.31933),
+        (90.0, Vec3::new(0.0, 0.0, -1.0), 2.5),
+        (90.0, Vec3::new(1.0, 0.0, 0.0), 4.5),
+        (90.0, Vec3::new(0.0, 0.0, 1.0), 6.5),
+        (90.0, Vec3::new(-1.0, 0.0, 0.0), 4.5),
+        (90.0, Vec3::new(0.6, 0.0, -0.8), 3.31933),
+    ];
+    let dir = tempfile::tempdir().unwrap();
+    exr_8x4(&dir.path().join("env.exr"));
+    for rot in [0.0, 90.0] {
+        let xml = scene(&format!(
+            r#"<emitter type="envmap"><string name="filename" value="env.exr"/>
+               <float name="scale" value="2"/>
+               <transform name="to_world"><rotate y="1" angle="{rot}"/></transform></emitter>"#
+        ));
+        std::fs::write(dir.path().join("scene.xml"), xml).unwrap();
+        let desc = load_scene_with(&dir.path().join("scene.xml"), &LoadOptions::default())
+            .unwrap()
+            .desc;
+        let scene = build(&desc).unwrap();
+        let env = scene.light(scene.infinite_lights[0]);
+        for &(_, d, red) in expected.iter().filter(|e| e.0 == rot) {
+            let le = env.le(&Ray::new(Vec3::ZERO, d));
+            // `scale` 2 doubles the map.
+            assert_close(le, 2.0 * Vec3::new(red, 2.5, 1.0), 1e-3);
+        }
+    }
+    let e = load_err(
+        r#"<emitter type="envmap"><string name="filename" value="missing.exr"/></emitter>"#,
+    );
+    assert!(e.contains("missing.exr"), "{e}");
+}
+
+#[test]
+fn constant_emitters_and_hidden_emitters() {
+    let desc =
+        load(r#"<emitter type="constant"><rgb name="radiance" value="0.5, 0.25, 1"/></emitter>"#)
+            .desc;
+    let scene = build(&desc).unwrap();
+    let env = scene.light(scene.infinite_lights[0]);
+    assert_eq!(
+        env.le(&Ray::new(Vec3::ZERO, Vec3::Y)),
+        Vec3::new(0.5, 0.25, 1.0)
+    );
+    let e = load_err(r#"<emitter type="constant"/><emitter type="constant"/>"#);
+    assert!(e.contains("at most one"), "{e}");
+
+    // Mitsuba 3.9.1: rectangle scaled 0.5 with area radiance 3 and no BSDF, constant sky
+    // 0.5, camera at z = 5, fov 40, 16 × 16, max_depth 3: centre pixel exactly 3 (an
+    // emitter without a BSDF does not reflect) and corner 0.5; with hide_emitters both
+    // are 0. With a diffuse BSDF on the square, the centre is 3.26 without and 0 with
+    // hide_emitters: a camera ray that hits an emitter returns nothing at all.
+    let body = |hide: bool| {
+        format!(
+            r#"<integrator type="path"><integer name="max_depth" value="3"/>
+               <boolean name="hide_emitters" value="{hide}"/></integrator>
+               <sensor type="perspective"><float name="fov" value="40"/>
+                 <transform name="to_world"><lookat origin="0, 0, 5" target="0, 0, 0" up="0, 1, 0"/></transform>
+                 <film type="hdrfilm"><integer name="width" value="16"/><integer name="height" value="16"/>
+                   <rfilter type="box"/></film>
+                 <sampler type="independent"><integer name="sample_count" value="4"/></sampler></sensor>
+               <shape type="rectangle"><transform name="to_world"><scale x="0.5" y="0.5"/></transform>
+                 <emitter type="area"><rgb name="radiance" value="3"/></emitter></shape>
+               <emitter type="constant"><rgb name="radiance" value="0.5"/></emitter>"#
+        )
+    };
+    for (hide, centre, corner) in [(false, 3.0, 0.5), (true, 0.0, 0.0)] {
+        let desc = load(&body(hide)).desc;
+        assert_eq!(desc.render.hide_emitters, hide);
+        let scene = build(&desc).unwrap();
+        let spp = desc.render.spp;
+        let r = candela_core::integrator::render(&scene, 0..spp, &AtomicBool::new(false), &|_| {});
+        let img = r.film.resolve();
+        let px = |x: usize, y: usize| img[y * 16 + x];
+        assert_close(px(8, 8), Vec3::splat(centre), 1e-4);
+        assert_close(px(0, 0), Vec3::splat(corner), 1e-4);
+    }
+}
+
+#[test]
+fn unknown_plugins_name_themselves() {
+    for (body, what) in [
+        (
+            r#"<shape type="cube"><bsdf type="principled"/></shape>"#,
+            "<bsdf type=\"principled\"> is not supported",
+        ),
+        (
+            r#"<shape type="cube"><bsdf type="diffuse"><texture type="wireframe" name="reflectance"/></bsdf></shape>"#,
+            "<texture type=\"wireframe\"> is not supported",
+        ),
+        (
+            r#"<emitter type="sunsky"/>"#,
+            "<emitter type=\"sunsky\"> is not supported",
+        ),
+    ] {
+        let e = load_err(body);
+        assert!(e.contains(what) && e.contains("scene.xml:2:"), "{e}");
+        let loaded = load_files(&[("scene.xml", scene(body).as_bytes())], true).unwrap();
+        assert!(
+            loaded.warnings.iter().any(|w| w.contains(what)),
+            "{:?}",
+            loaded.warnings
+        );
+    }
+}
