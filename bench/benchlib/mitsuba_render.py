@@ -39,13 +39,18 @@ def libllvm_path() -> Optional[str]:
         return None
 
 
-def run(scene: str, out: str, *, variant: str, threads: int, spp: int, max_depth: int,
-        res: int, seed: int = 0, passes: int = 1, warm_runs: int = 0,
-        cold_kernel_cache: bool = False, timeout_s: float = 3600) -> dict:
+def run(scene: str, out: str, *, variant: str, threads: int, spp: int = 0,
+        max_depth: int = 0, res: int = 0, params: Optional[dict] = None, seed: int = 0,
+        passes: int = 1, warm_runs: int = 0, cold_kernel_cache: bool = False,
+        timeout_s: float = 3600) -> dict:
     """Render in a child process and return its JSON report (see `_child`).
 
+    The scene's parameters are `params` (name → value, as `-D` gives them) when given,
+    otherwise `spp`, `max_depth` and `res` (the benchmark scenes' parameters).
     `cold_kernel_cache` points Dr.Jit's on-disk kernel cache (~/.drjit) at an empty
     directory, so that the first render really compiles its kernels."""
+    if params is None:
+        params = {"spp": spp, "max_depth": max_depth, "res": res}
     env = dict(os.environ)
     if variant.startswith("llvm"):
         path = libllvm_path()
@@ -53,8 +58,8 @@ def run(scene: str, out: str, *, variant: str, threads: int, spp: int, max_depth
             raise RuntimeError("no libLLVM: run bench/setup.sh or set DRJIT_LIBLLVM_PATH")
         env["DRJIT_LIBLLVM_PATH"] = path
     cmd = [VENV_PYTHON, "-m", "benchlib.mitsuba_render", "--scene", scene, "--out", out,
-           "--variant", variant, "--threads", str(threads), "--spp", str(spp),
-           "--max-depth", str(max_depth), "--res", str(res), "--seed", str(seed),
+           "--variant", variant, "--threads", str(threads), "--params", json.dumps(params),
+           "--seed", str(seed),
            "--passes", str(passes), "--warm-runs", str(warm_runs)]
     with tempfile.TemporaryDirectory(prefix="drjit-home-") as home:
         if cold_kernel_cache:
@@ -98,7 +103,8 @@ def _child(a: argparse.Namespace) -> dict:
     import_s = time.perf_counter() - t0
 
     t0 = time.perf_counter()
-    scene = mi.load_file(a.scene, spp=a.spp, max_depth=a.max_depth, res=a.res)
+    params = json.loads(a.params)
+    scene = mi.load_file(a.scene, **{k: str(v) for k, v in params.items()})
     load_s = time.perf_counter() - t0
 
     def timed_render(seed: int):
@@ -127,8 +133,7 @@ def _child(a: argparse.Namespace) -> dict:
     mi.Bitmap(mean.astype(np.float32)).write(a.out)
     return {
         "variant": a.variant, "mitsuba": mi.__version__, "drjit": dr.__version__,
-        "threads": dr.thread_count(), "spp": a.spp, "max_depth": a.max_depth,
-        "res": a.res, "passes": a.passes, "import_s": import_s, "load_s": load_s,
+        "threads": dr.thread_count(), "params": params, "passes": a.passes, "import_s": import_s, "load_s": load_s,
         "renders": renders, "warm": warm, "out": a.out,
         "peak_rss_mib": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024,
     }
@@ -140,10 +145,8 @@ def main() -> None:
     ap.add_argument("--out", required=True)
     ap.add_argument("--variant", default="scalar_rgb")
     ap.add_argument("--threads", type=int, default=2)
-    ap.add_argument("--spp", type=int, default=64)
-    ap.add_argument("--max-depth", type=int, required=True,
-                    help="Mitsuba's max_depth (path segments): Candela's + 1")
-    ap.add_argument("--res", type=int, default=512)
+    ap.add_argument("--params", required=True,
+                    help="the scene's parameters as a JSON object, e.g. {\"spp\": 64}")
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--passes", type=int, default=1)
     ap.add_argument("--warm-runs", type=int, default=0)

@@ -14,9 +14,10 @@ use crate::bvh::Bvh;
 use crate::camera::Camera;
 use crate::desc::{
     ApertureDesc, ApertureSizeDesc, BsdfDesc, CameraDesc, EnvironmentDesc, EnvironmentMapDesc,
-    FocusDesc, GeometryDesc, ImageDesc, LensDesc, MeshDesc, SceneDesc, ShapeDesc, Span,
-    TextureDesc,
+    FocusDesc, GeometryDesc, ImageDesc, LensDesc, MeshDesc, PixelFilterDesc, SceneDesc, ShapeDesc,
+    Span, TextureDesc,
 };
+use crate::filter::PixelFilter;
 use crate::geometry::Aabb;
 use crate::light::envmap::{Cubemap, Equirect, Image};
 use crate::light::{EnvironmentLight, EnvironmentMap, Light, LightId, SphereLight};
@@ -79,6 +80,7 @@ pub fn build(desc: &SceneDesc) -> Result<Scene, BuildError> {
     if r.spp == 0 {
         return err(&Span::code(), "spp must be at least 1");
     }
+    let filter = build_filter(r.filter)?;
     let camera = build_camera(desc)?;
 
     let mut materials = Vec::with_capacity(desc.materials.len());
@@ -190,6 +192,7 @@ pub fn build(desc: &SceneDesc) -> Result<Scene, BuildError> {
 
     Ok(Scene {
         camera,
+        filter,
         settings: r.clone(),
         meshes,
         spheres,
@@ -395,6 +398,21 @@ fn validate_lens(c: &CameraDesc, lens: &LensDesc) -> Result<(), BuildError> {
         }
     }
     Ok(())
+}
+
+fn build_filter(f: PixelFilterDesc) -> Result<PixelFilter, BuildError> {
+    let (radius, stddev) = match f {
+        PixelFilterDesc::Box => (1.0, 1.0),
+        PixelFilterDesc::Tent { radius } => (radius, 1.0),
+        PixelFilterDesc::Gaussian { stddev, radius } => (radius, stddev),
+    };
+    if !(radius.is_finite() && radius > 0.0 && stddev.is_finite() && stddev > 0.0) {
+        return err(
+            &Span::code(),
+            format!("pixel filter {f:?} needs a positive, finite radius and stddev"),
+        );
+    }
+    Ok(PixelFilter::new(f))
 }
 
 /// The render-time texture of a description, checked (`what` names it in errors).

@@ -536,6 +536,23 @@ pub struct RenderSettings {
     /// Camera rays that hit an emitter or escape to the environment return nothing at
     /// all, as with Mitsuba's `hide_emitters` (the emitters still light the scene).
     pub hide_emitters: bool,
+    pub filter: PixelFilterDesc,
+}
+
+/// The pixel reconstruction filter (see [`crate::filter`]); radii in pixels.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub enum PixelFilterDesc {
+    /// Each pixel averages its own square.
+    #[default]
+    Box,
+    Tent {
+        radius: f32,
+    },
+    /// Truncated at `radius` (Mitsuba: σ = 0.5, radius 4σ).
+    Gaussian {
+        stddev: f32,
+        radius: f32,
+    },
 }
 
 impl Default for RenderSettings {
@@ -550,6 +567,7 @@ impl Default for RenderSettings {
             light_sampler: LightSamplerKind::default(),
             ris_candidates: DEFAULT_RIS_CANDIDATES,
             hide_emitters: false,
+            filter: PixelFilterDesc::Box,
         }
     }
 }

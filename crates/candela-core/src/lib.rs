@@ -35,6 +35,7 @@ pub mod chi2;
 pub mod color;
 pub mod desc;
 pub mod film;
+pub mod filter;
 pub mod geometry;
 pub mod integrator;
 pub mod light;

@@ -6,6 +6,7 @@ use glam::{Vec2, Vec3};
 use crate::bvh::Bvh;
 use crate::camera::Camera;
 use crate::desc::RenderSettings;
+use crate::filter::PixelFilter;
 use crate::geometry::{intersect_sphere, Aabb, Ray, WatertightRay};
 use crate::light::{Light, LightId};
 use crate::light_sampler::LightSampler;
@@ -109,6 +110,7 @@ impl SurfaceInteraction {
 #[derive(Clone, Debug)]
 pub struct Scene {
     pub camera: Camera,
+    pub filter: PixelFilter,
     pub settings: RenderSettings,
     pub meshes: Vec<Mesh>,
     pub spheres: Vec<Sphere>,

@@ -1,7 +1,9 @@
 //! `<sensor>` (with its `<film>` and `<sampler>`) and `<integrator>`: the camera and the
 //! render settings.
 
-use candela_core::desc::{ApertureDesc, ApertureSizeDesc, CameraDesc, FocusDesc, LensDesc};
+use candela_core::desc::{
+    ApertureDesc, ApertureSizeDesc, CameraDesc, FocusDesc, LensDesc, PixelFilterDesc,
+};
 use glam::{Mat4, Vec3};
 
 use super::parse::Node;
@@ -47,7 +49,7 @@ pub(crate) fn integrator(ctx: &mut Ctx, node: &Node) -> Result<(), LoadError> {
             let p = node.prop("rr_depth").expect("read just now");
             ctx.warn(
                 p,
-                "rr_depth is ignored: Candela's Russian roulette starts after 3 bounces",
+                "rr_depth is ignored: Candela's Russian roulette starts after 5 bounces",
             );
         }
     }
@@ -175,19 +177,31 @@ fn film(ctx: &mut Ctx, node: &Node) -> Result<(), LoadError> {
         node.string(s)?;
     }
     node.boolean("banner")?;
+    // Mitsuba's default filter is a Gaussian of σ = 0.5 pixels, truncated at 4σ.
+    let gaussian = PixelFilterDesc::Gaussian {
+        stddev: 0.5,
+        radius: 2.0,
+    };
+    ctx.desc.render.filter = gaussian;
     for f in node.plugins("rfilter") {
-        match f.kind() {
-            "box" => {}
-            "gaussian" | "tent" => ctx.warn(
-                f,
-                format!(
-                    "Candela uses a box filter; the {} filter's extra blur is not reproduced",
-                    f.kind()
-                ),
-            ),
-            _ => ctx.unsupported(f, format!("<{}> is not supported", describe(f)))?,
-        }
-        f.children.iter().for_each(|c| c.used.set(true));
+        ctx.desc.render.filter = match f.kind() {
+            "box" => PixelFilterDesc::Box,
+            "tent" => PixelFilterDesc::Tent {
+                radius: positive(f, "radius", 1.0)?,
+            },
+            "gaussian" => {
+                let stddev = positive(f, "stddev", 0.5)?;
+                PixelFilterDesc::Gaussian {
+                    stddev,
+                    radius: 4.0 * stddev,
+                }
+            }
+            _ => {
+                ctx.unsupported(f, format!("<{}> is not supported", describe(f)))?;
+                gaussian
+            }
+        };
+        ctx.check_unused(f)?;
     }
     ctx.check_unused(node)
 }
@@ -214,4 +228,13 @@ fn sampler(ctx: &mut Ctx, node: &Node) -> Result<(), LoadError> {
     }
     node.boolean("jitter")?;
     ctx.check_unused(node)
+}
+
+/// A positive float property of a filter, with its default.
+fn positive(node: &Node, name: &str, default: f32) -> Result<f32, LoadError> {
+    match node.float(name)? {
+        None => Ok(default),
+        Some(v) if v > 0.0 => Ok(v),
+        Some(v) => Err(node.error(format!("{name} must be positive, got {v}"))),
+    }
 }
