@@ -342,7 +342,10 @@ fn textured_spheres_carry_mitsubas_uvs() {
         )
     };
     let plain = load(&shape("")).desc;
-    assert!(matches!(plain.shapes[0].geometry, GeometryDesc::Sphere { .. }));
+    assert!(matches!(
+        plain.shapes[0].geometry,
+        GeometryDesc::Sphere { .. }
+    ));
     let desc = load(&shape(
         r#"<bsdf type="diffuse"><texture type="checkerboard" name="reflectance"/></bsdf>"#,
     ))
@@ -364,7 +367,11 @@ fn textured_spheres_carry_mitsubas_uvs() {
         // Tessellated at 1/128 in u, 1/64 in v: within a triangle the uv is linear in the
         // position, off by second-order terms (< 10⁻³); a mirrored u or a pole on another
         // axis is off by 0.1 or more.
-        assert!((si.uv - Vec2::from(uv)).abs().max_element() < 2e-3, "{} vs {uv:?}", si.uv);
+        assert!(
+            (si.uv - Vec2::from(uv)).abs().max_element() < 2e-3,
+            "{} vs {uv:?}",
+            si.uv
+        );
         assert_close(si.p, Vec3::from(p), 2e-3);
         assert!(si.ns.dot(n) > 0.999, "normal {} at {p:?}", si.ns);
     }

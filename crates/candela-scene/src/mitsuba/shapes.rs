@@ -155,7 +155,11 @@ pub(crate) fn uv_sphere(center: Vec3, radius: f32) -> MeshDesc {
         for j in 0..=segments {
             let u = j as f32 / segments as f32;
             let phi = u * std::f32::consts::TAU;
-            let d = Vec3::new(theta.sin() * phi.cos(), theta.sin() * phi.sin(), theta.cos());
+            let d = Vec3::new(
+                theta.sin() * phi.cos(),
+                theta.sin() * phi.sin(),
+                theta.cos(),
+            );
             mesh.positions.push(center + radius * d);
             mesh.normals.push(d);
             mesh.uvs.push(Vec2::new(u, v));
