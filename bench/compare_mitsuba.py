@@ -161,6 +161,26 @@ def noise_floor(relmse_mitsuba: float, spp: int, ref_spp: int) -> float:
     return relmse_mitsuba * r / (1 + r)
 
 
+def measure_equal_time(scene: str, tag: str, params: dict, a, variants: list,
+                       runs: dict) -> dict:
+    """Checks the extrapolation: each Mitsuba variant renders once more with its spp
+    scaled so that it takes Candela's median time (variant → spp, seconds, image)."""
+    t_c = statistics.median(r["time_s"] for r in runs["candela"])
+    found = {}
+    for v in variants:
+        t_v = statistics.median(r["warm_s"] or r["time_s"] for r in runs[v])
+        spp = max(1, round(a.spp * t_c / t_v))
+        print(f"[compare] {tag}: mitsuba {v} at Candela's time: {spp} spp", flush=True)
+        out = os.path.join(OUT, f"{tag}_{v}_equal_time.exr")
+        r = mitsuba_render.run(scene, out, variant=v, threads=a.threads,
+                               params=dict(params, **({"spp": spp} if "spp" in params else {})),
+                               seed=1000, render_spp=spp,
+                               warm_runs=1 if v.startswith("llvm") else 0)
+        time_s = r["warm"][0]["wall_s"] if r["warm"] else r["renders"][0]["wall_s"]
+        found[v] = {"spp": spp, "time_s": time_s, "out": out}
+    return found
+
+
 def run_candela(scene: str, out: str, params: dict, a, seed: int) -> dict:
     defines = [x for k, v in params.items() for x in ("-D", f"{k}={v}")]
     cmd = [CANDELA, "render", scene, "-o", out, "--threads", str(a.threads),
@@ -200,6 +220,8 @@ def compare(scene: str, a, variants: list) -> str:
             warm = r["warm"][0]["wall_s"] if r["warm"] else None
             runs[v].append({"time_s": r["renders"][0]["wall_s"], "warm_s": warm,
                             "cpu_s": r["renders"][0]["cpu_s"], "out": out})
+    equal_time = measure_equal_time(scene, tag, params, a, variants, runs) \
+        if a.measure_equal_time else {}
 
     import mitsuba as mi  # EXR I/O only
     mi.set_variant("scalar_rgb")
@@ -240,6 +262,12 @@ def compare(scene: str, a, variants: list) -> str:
                      "—" if key == "candela" else report.fmt(s["net"] * s["t"]
                                                              / (c["net"] * c["t"])),
                      report.fmt_rgb(s["z"], 1)])
+    measured = []
+    for v, e in equal_time.items():
+        m = images.relmse(images.load_exr(e["out"]), ref) - floor
+        measured.append(f"{NAME[v]} at {e['spp']} spp took {e['time_s']:.2f} s (Candela "
+                        f"{c['t']:.2f} s): relMSE − ref noise {m:.5f}, extrapolated "
+                        f"{stats[v]['net'] * stats[v]['t'] / c['t']:.5f}")
     defines = " ".join(f"-D {k}={v}" for k, v in params.items())
     rel = os.path.relpath(source, REPO)
     return "\n".join([
@@ -257,6 +285,8 @@ def compare(scene: str, a, variants: list) -> str:
            else " (taken as converged: nothing subtracted). ") +
         f"Candela: `{runs['candela'][0]['command'].replace(REPO + '/', '')}`.",
         "",
+    ] + ([("Measured at equal time (one run each, to check the extrapolation): "
+           + "; ".join(measured) + "."), ""] if measured else []) + [
     ])
 
 
@@ -277,6 +307,11 @@ def main() -> None:
                     "(default); file: the file's own filter")
     ap.add_argument("--variants", default="llvm_ad_rgb,scalar_rgb")
     ap.add_argument("--skip-build", action="store_true")
+    ap.add_argument("--measure-equal-time", action="store_true",
+                    help="also render each Mitsuba variant once at the spp that takes "
+                    "Candela's time, to check the extrapolated equal-time relMSE")
+    ap.add_argument("--output", default=os.path.join(BENCH_DIR, "out", "compare_mitsuba.md"),
+                    help="where the markdown is written besides stdout")
     a = ap.parse_args()
     variants = [v for v in a.variants.split(",") if v]
     if "llvm_ad_rgb" in variants and mitsuba_render.libllvm_path() is None:
@@ -313,7 +348,8 @@ def main() -> None:
         "flags a bias at α = 0.001, reference differences included).")
     md = "\n".join(parts)
     print("\n" + md)
-    with open(os.path.join(BENCH_DIR, "out", "compare_mitsuba.md"), "w") as f:
+    os.makedirs(os.path.dirname(os.path.abspath(a.output)), exist_ok=True)
+    with open(a.output, "w") as f:
         f.write(md + "\n")
 
 
