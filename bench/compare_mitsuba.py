@@ -14,7 +14,7 @@ are applied to the relMSE less the reference's own noise (estimated, see `noise_
 By default every scene's pixel filter is replaced by a box (`--rfilter file` keeps the
 file's): Mitsuba splats each sample into every pixel its filter reaches, Candela samples
 the filter (filter importance sampling). Both have the same expected image, but splatting
-averages neighbouring pixels' samples, so with a tent its per-pixel variance is ~2.4×
+averages neighbouring pixels' samples, so with a tent its per-pixel variance is ~2.6×
 lower at equal spp (measured on the Cornell box) — a property of the filter, not of the
 light transport. With a box both estimators are per-pixel averages and compare directly.
 """
