@@ -8,7 +8,15 @@ bench/out/compare_mitsuba.md). Run through bench/compare_mitsuba.
 
 Equal time and equal error are extrapolated from one measured run each, using that an
 unbiased Monte Carlo estimate's MSE falls as 1/spp, and render time grows with spp:
-relMSE at time T = relMSE · t / T, and the time to reach error E = t · relMSE / E.
+relMSE at time T = relMSE · t / T, and the time to reach error E = t · relMSE / E. Both
+are applied to the relMSE less the reference's own noise (estimated, see `noise_floor`).
+
+By default every scene's pixel filter is replaced by a box (`--rfilter file` keeps the
+file's): Mitsuba splats each sample into every pixel its filter reaches, Candela samples
+the filter (filter importance sampling). Both have the same expected image, but splatting
+averages neighbouring pixels' samples, so with a tent its per-pixel variance is ~2.6×
+lower at equal spp (measured on the Cornell box) — a property of the filter, not of the
+light transport. With a box both estimators are per-pixel averages and compare directly.
 """
 
 import argparse
@@ -60,9 +68,42 @@ def scene_params(path: str, spp: int, res: int) -> dict:
     return params
 
 
-def fingerprint(path: str, params: dict) -> str:
+def prepare(scene: str, tag: str, a) -> str:
+    """The scene file both renderers read: the file itself with `--rfilter file`, else a
+    copy in bench/out/compare/ whose `rfilter` is a box (added where the film has none:
+    Mitsuba's default is a Gaussian) and whose relative file names are made absolute."""
+    if a.rfilter == "file":
+        return scene
+    with open(scene) as f:
+        xml = f.read()
+    folder = os.path.dirname(scene)
+    xml, n = re.subn(r"<rfilter\b[^>]*?/>|<rfilter\b[^>]*>.*?</rfilter>",
+                     '<rfilter type="box"/>', xml, flags=re.S)
+    if n == 0:
+        xml, n = re.subn(r"</film>", '<rfilter type="box"/></film>', xml)
+    if n == 0:
+        raise RuntimeError("no <film> to give a box filter (use --rfilter file)")
+
+    def absolute(m: re.Match) -> str:
+        name = m.group(2)
+        if "$" in name or os.path.isabs(name):
+            return m.group(0)
+        return m.group(1) + os.path.normpath(os.path.join(folder, name)) + '"'
+    xml = re.sub(r'(<string\s+name="filename"\s+value=")([^"]*)"', absolute, xml)
+    xml = re.sub(r'(<include\s+filename=")([^"]*)"', absolute, xml)
+    out = os.path.join(OUT, f"{tag}_box.xml")
+    with open(out, "w") as f:
+        f.write(xml)
+    return out
+
+
+def fingerprint(path: str, params: dict, source: str) -> str:
+    """Hash of the scene file read, the files beside the original `source`, and the
+    parameters: a cached reference is reused only while all are unchanged."""
     h = hashlib.sha256(json.dumps(params, sort_keys=True).encode())
-    folder = os.path.dirname(path)
+    with open(path, "rb") as f:
+        h.update(f.read())
+    folder = os.path.dirname(source)
     for root, _, files in sorted(os.walk(folder)):
         for name in sorted(files):
             if name.endswith((".xml", ".obj", ".ply", ".exr", ".hdr", ".png", ".jpg")):
@@ -71,10 +112,10 @@ def fingerprint(path: str, params: dict) -> str:
     return h.hexdigest()[:16]
 
 
-def reference(scene: str, tag: str, params: dict, a, variant: str) -> str:
+def reference(scene: str, tag: str, params: dict, a, variant: str, source: str) -> str:
     passes = max(1, a.ref_spp // REF_PASS_SPP)
     ref_params = dict(params, **({"spp": REF_PASS_SPP} if "spp" in params else {}))
-    want = {"fingerprint": fingerprint(scene, ref_params), "passes": passes}
+    want = {"fingerprint": fingerprint(scene, ref_params, source), "passes": passes}
     path = os.path.join(OUT, f"{tag}_reference.exr")
     meta_path = path + ".json"
     if os.path.exists(path) and os.path.exists(meta_path):
@@ -85,16 +126,65 @@ def reference(scene: str, tag: str, params: dict, a, variant: str) -> str:
     print(f"[compare] {tag}: rendering the reference, {passes} × {REF_PASS_SPP} spp with "
           f"{variant} (cached in bench/out/compare/)", flush=True)
     r = mitsuba_render.run(scene, path, variant=variant, threads=a.threads,
-                           params=ref_params, seed=REF_SEED, passes=passes)
+                           params=ref_params, seed=REF_SEED, passes=passes,
+                           render_spp=REF_PASS_SPP)
     with open(meta_path, "w") as f:
         json.dump(dict(want, variant=variant, mitsuba=r["mitsuba"]), f, indent=1)
     return path
 
 
+def given_reference(a, source: str) -> str:
+    """The EXR `--reference` names: 'tungsten' is the TungstenRender.exr beside the scene."""
+    path = (os.path.join(os.path.dirname(source), "TungstenRender.exr")
+            if a.reference == "tungsten" else a.reference)
+    if not os.path.exists(path):
+        raise RuntimeError(f"no reference image {path}")
+    return path
+
+
+def fit_to(ref, shape: tuple):
+    """A reference larger by an integer factor (the 1024² Tungsten renders against a
+    256² run) is averaged over blocks, which is the run's box-filtered pixel."""
+    fy, fx = ref.shape[0] // shape[0], ref.shape[1] // shape[1]
+    if (fy * shape[0], fx * shape[1]) != ref.shape[:2] or fy < 1 or fx < 1:
+        raise RuntimeError(f"the reference is {ref.shape[1]}x{ref.shape[0]}, not a multiple "
+                           f"of the {shape[1]}x{shape[0]} images")
+    return ref.reshape(shape[0], fy, shape[1], fx, 3).mean(axis=(1, 3))
+
+
+def noise_floor(relmse_mitsuba: float, spp: int, ref_spp: int) -> float:
+    """The reference's own noise in a relMSE, where the reference is a Mitsuba render of
+    ref_spp samples: an image of spp samples from the same estimator has relMSE
+    v·(1 + spp/ref_spp) against it (independent seeds), so that share is
+    relmse·r/(1 + r), r = spp/ref_spp, and it adds to every renderer's relMSE alike."""
+    r = spp / ref_spp
+    return relmse_mitsuba * r / (1 + r)
+
+
+def measure_equal_time(scene: str, tag: str, params: dict, a, variants: list,
+                       runs: dict) -> dict:
+    """Checks the extrapolation: each Mitsuba variant renders once more with its spp
+    scaled so that it takes Candela's median time (variant → spp, seconds, image)."""
+    t_c = statistics.median(r["time_s"] for r in runs["candela"])
+    found = {}
+    for v in variants:
+        t_v = statistics.median(r["warm_s"] or r["time_s"] for r in runs[v])
+        spp = max(1, round(a.spp * t_c / t_v))
+        print(f"[compare] {tag}: mitsuba {v} at Candela's time: {spp} spp", flush=True)
+        out = os.path.join(OUT, f"{tag}_{v}_equal_time.exr")
+        r = mitsuba_render.run(scene, out, variant=v, threads=a.threads,
+                               params=dict(params, **({"spp": spp} if "spp" in params else {})),
+                               seed=1000, render_spp=spp,
+                               warm_runs=1 if v.startswith("llvm") else 0)
+        time_s = r["warm"][0]["wall_s"] if r["warm"] else r["renders"][0]["wall_s"]
+        found[v] = {"spp": spp, "time_s": time_s, "out": out}
+    return found
+
+
 def run_candela(scene: str, out: str, params: dict, a, seed: int) -> dict:
     defines = [x for k, v in params.items() for x in ("-D", f"{k}={v}")]
     cmd = [CANDELA, "render", scene, "-o", out, "--threads", str(a.threads),
-           "--seed", str(seed)] + defines
+           "--seed", str(seed), "--spp", str(a.spp)] + defines
     c0 = candela._children_cpu_s()
     p = subprocess.run(cmd, cwd=REPO, capture_output=True, text=True)
     if p.returncode != 0:
@@ -109,9 +199,12 @@ def run_candela(scene: str, out: str, params: dict, a, seed: int) -> dict:
 def compare(scene: str, a, variants: list) -> str:
     tag = os.path.basename(os.path.dirname(scene)) if scene.endswith("scene.xml") \
         else os.path.splitext(os.path.basename(scene))[0]
+    source = scene
     params = scene_params(scene, a.spp, a.res)
+    scene = prepare(scene, tag, a)
     ref_variant = "llvm_ad_rgb" if "llvm_ad_rgb" in variants else "scalar_rgb"
-    ref_path = a.reference or reference(scene, tag, params, a, ref_variant)
+    ref_path = given_reference(a, source) if a.reference else \
+        reference(scene, tag, params, a, ref_variant, source)
     runs = {k: [] for k in ["candela"] + variants}
     for rep in range(a.repeats):
         out = os.path.join(OUT, f"{tag}_candela_{rep}.exr")
@@ -121,15 +214,21 @@ def compare(scene: str, a, variants: list) -> str:
             print(f"[compare] {tag} run {rep + 1}/{a.repeats}: mitsuba {v}", flush=True)
             out = os.path.join(OUT, f"{tag}_{v}_{rep}.exr")
             r = mitsuba_render.run(scene, out, variant=v, threads=a.threads, params=params,
-                                   seed=rep, warm_runs=1 if v.startswith("llvm") else 0,
+                                   seed=rep, render_spp=a.spp,
+                                   warm_runs=1 if v.startswith("llvm") else 0,
                                    cold_kernel_cache=v.startswith("llvm"))
             warm = r["warm"][0]["wall_s"] if r["warm"] else None
             runs[v].append({"time_s": r["renders"][0]["wall_s"], "warm_s": warm,
                             "cpu_s": r["renders"][0]["cpu_s"], "out": out})
+    equal_time = measure_equal_time(scene, tag, params, a, variants, runs) \
+        if a.measure_equal_time else {}
 
     import mitsuba as mi  # EXR I/O only
     mi.set_variant("scalar_rgb")
     ref = images.load_exr(ref_path)
+    shape = images.load_exr(runs["candela"][0]["out"]).shape
+    if ref.shape != shape:
+        ref = fit_to(ref, shape[:2])
     stats = {}
     for key, rs in runs.items():
         imgs = [images.load_exr(r["out"]) for r in rs]
@@ -143,32 +242,51 @@ def compare(scene: str, a, variants: list) -> str:
                       "t_cold": statistics.median(r["time_s"] for r in rs),
                       "relmse": statistics.mean(images.relmse(x, ref) for x in imgs),
                       "z": images.mean_difference_z(imgs[0], ref)}
+    floor = 0.0
+    if not a.reference and variants:
+        floor = noise_floor(statistics.mean(stats[v]["relmse"] for v in variants), a.spp,
+                            max(1, a.ref_spp // REF_PASS_SPP) * REF_PASS_SPP)
+    for s in stats.values():
+        s["net"] = max(s["relmse"] - floor, 1e-12)
     c = stats["candela"]
     rows = []
     for key in ["candela"] + variants:
         s = stats[key]
-        at_candela_time = s["relmse"] * s["t"] / c["t"]
-        to_candela_error = s["t"] * s["relmse"] / c["relmse"]
-        candela_to_this = c["t"] * c["relmse"] / s["relmse"]
+        at_candela_time = s["net"] * s["t"] / c["t"]
+        to_candela_error = s["t"] * s["net"] / c["net"]
+        candela_to_this = c["t"] * c["net"] / s["net"]
         rows.append([NAME[key], report.fmt(s["t"]), report.fmt(s["t_cold"]),
-                     f"{s['relmse']:.5f}", f"{at_candela_time:.5f}",
+                     f"{s['relmse']:.5f}", f"{s['net']:.5f}", f"{at_candela_time:.5f}",
                      report.fmt(to_candela_error),
                      "—" if key == "candela" else report.fmt(candela_to_this),
-                     "—" if key == "candela" else report.fmt(s["relmse"] * s["t"]
-                                                             / (c["relmse"] * c["t"])),
+                     "—" if key == "candela" else report.fmt(s["net"] * s["t"]
+                                                             / (c["net"] * c["t"])),
                      report.fmt_rgb(s["z"], 1)])
+    measured = []
+    for v, e in equal_time.items():
+        m = images.relmse(images.load_exr(e["out"]), ref) - floor
+        measured.append(f"{NAME[v]} at {e['spp']} spp took {e['time_s']:.2f} s (Candela "
+                        f"{c['t']:.2f} s): relMSE − ref noise {m:.5f}, extrapolated "
+                        f"{stats[v]['net'] * stats[v]['t'] / c['t']:.5f}")
     defines = " ".join(f"-D {k}={v}" for k, v in params.items())
-    rel = os.path.relpath(scene, REPO)
+    rel = os.path.relpath(source, REPO)
     return "\n".join([
-        f"#### `{rel}` ({defines or 'file defaults'}), {a.threads} threads",
+        f"#### `{rel}` ({defines or 'file defaults'}), {a.spp} spp, "
+        f"{shape[1]}×{shape[0]}, {a.threads} threads, "
+        + ("box filter for both" if a.rfilter == "box" else "the file's filter"),
         "",
-        report.table(["renderer", "time s", "cold s", "relMSE", "relMSE at Candela's time",
+        report.table(["renderer", "time s", "cold s", "relMSE", "relMSE − ref noise",
+                      "relMSE at Candela's time",
                       "s to Candela's error", "Candela s to this error",
                       "efficiency ÷ Candela's", "mean z vs ref (R, G, B)"], rows),
         "",
-        f"Reference: {os.path.relpath(ref_path, REPO) if not a.reference else a.reference}. "
+        f"Reference: {os.path.relpath(ref_path, REPO)}"
+        + (f" (estimated noise in every relMSE: {floor:.5f}). " if not a.reference
+           else " (taken as converged: nothing subtracted). ") +
         f"Candela: `{runs['candela'][0]['command'].replace(REPO + '/', '')}`.",
         "",
+    ] + ([("Measured at equal time (one run each, to check the extrapolation): "
+           + "; ".join(measured) + "."), ""] if measured else []) + [
     ])
 
 
@@ -181,9 +299,19 @@ def main() -> None:
     ap.add_argument("--threads", type=int, default=2)
     ap.add_argument("--repeats", type=int, default=1)
     ap.add_argument("--ref-spp", type=int, default=1024)
-    ap.add_argument("--reference", help="an EXR to use as the reference (one scene only)")
+    ap.add_argument("--reference", help="an EXR to use as the reference (one scene only; "
+                    "block-averaged when an integer multiple of the resolution), or "
+                    "'tungsten': the TungstenRender.exr beside each scene")
+    ap.add_argument("--rfilter", choices=["box", "file"], default="box",
+                    help="box: both render a copy of the scene with a box pixel filter "
+                    "(default); file: the file's own filter")
     ap.add_argument("--variants", default="llvm_ad_rgb,scalar_rgb")
     ap.add_argument("--skip-build", action="store_true")
+    ap.add_argument("--measure-equal-time", action="store_true",
+                    help="also render each Mitsuba variant once at the spp that takes "
+                    "Candela's time, to check the extrapolated equal-time relMSE")
+    ap.add_argument("--output", default=os.path.join(BENCH_DIR, "out", "compare_mitsuba.md"),
+                    help="where the markdown is written besides stdout")
     a = ap.parse_args()
     variants = [v for v in a.variants.split(",") if v]
     if "llvm_ad_rgb" in variants and mitsuba_render.libllvm_path() is None:
@@ -199,20 +327,29 @@ def main() -> None:
              f"date {m['date']}; candela git {m['git']}; load before {machine.loadavg()}.",
              f"Command: `bench/compare_mitsuba {' '.join(sys.argv[1:])}`", ""]
     for scene in scenes:
-        parts.append(compare(scene, a, variants))
+        try:
+            parts.append(compare(scene, a, variants))
+        except Exception as e:  # one scene failing must not lose the others' figures
+            print(f"[compare] {scene} failed: {e}", flush=True)
+            parts += [f"#### `{os.path.relpath(scene, REPO)}`: not compared: "
+                      f"{str(e).strip().splitlines()[-1]}", ""]
     parts.append(
         "*time s*: render only (Candela's summary line; Mitsuba's `mi.render`, for "
         "llvm_ad_rgb the second render in the process, kernels compiled); *cold s*: "
         "Mitsuba's first render including JIT compilation. *relMSE*: mean over runs of "
-        f"(x − ref)²/(ref² + {images.RELMSE_EPS}), reference noise included. *relMSE at "
-        "Candela's time* = relMSE · t / t_Candela; *s to Candela's error* = "
+        f"(x − ref)²/(ref² + {images.RELMSE_EPS}), reference noise included; *relMSE − "
+        "ref noise* subtracts the reference's own noise, estimated from the Mitsuba runs "
+        "as relMSE·r/(1 + r), r = spp/ref_spp (same estimator as the reference), and is "
+        "what the next columns use. Extrapolated with relMSE ∝ 1/time, not measured: "
+        "*relMSE at Candela's time* = relMSE · t / t_Candela; *s to Candela's error* = "
         "t · relMSE / relMSE_Candela; *efficiency ÷ Candela's* = (relMSE · t) / "
         "(relMSE_Candela · t_Candela): above 1, Candela reaches equal error sooner. "
         "*mean z*: mean image difference to the reference in standard errors (|z| > 3.3 "
         "flags a bias at α = 0.001, reference differences included).")
     md = "\n".join(parts)
     print("\n" + md)
-    with open(os.path.join(BENCH_DIR, "out", "compare_mitsuba.md"), "w") as f:
+    os.makedirs(os.path.dirname(os.path.abspath(a.output)), exist_ok=True)
+    with open(a.output, "w") as f:
         f.write(md + "\n")
 
 

@@ -42,11 +42,13 @@ def libllvm_path() -> Optional[str]:
 def run(scene: str, out: str, *, variant: str, threads: int, spp: int = 0,
         max_depth: int = 0, res: int = 0, params: Optional[dict] = None, seed: int = 0,
         passes: int = 1, warm_runs: int = 0, cold_kernel_cache: bool = False,
-        timeout_s: float = 3600) -> dict:
+        render_spp: int = 0, timeout_s: float = 3600) -> dict:
     """Render in a child process and return its JSON report (see `_child`).
 
     The scene's parameters are `params` (name → value, as `-D` gives them) when given,
     otherwise `spp`, `max_depth` and `res` (the benchmark scenes' parameters).
+    `render_spp` > 0 overrides the scene's sample count in `mi.render` (for scenes
+    without an `$spp` parameter).
     `cold_kernel_cache` points Dr.Jit's on-disk kernel cache (~/.drjit) at an empty
     directory, so that the first render really compiles its kernels."""
     if params is None:
@@ -60,7 +62,8 @@ def run(scene: str, out: str, *, variant: str, threads: int, spp: int = 0,
     cmd = [VENV_PYTHON, "-m", "benchlib.mitsuba_render", "--scene", scene, "--out", out,
            "--variant", variant, "--threads", str(threads), "--params", json.dumps(params),
            "--seed", str(seed),
-           "--passes", str(passes), "--warm-runs", str(warm_runs)]
+           "--passes", str(passes), "--warm-runs", str(warm_runs),
+           "--spp", str(render_spp)]
     with tempfile.TemporaryDirectory(prefix="drjit-home-") as home:
         if cold_kernel_cache:
             env["HOME"] = home
@@ -111,7 +114,7 @@ def _child(a: argparse.Namespace) -> dict:
         from . import machine
         load = machine.loadavg()
         c0, t0 = _cpu_s(), time.perf_counter()
-        img = mi.render(scene, seed=seed)
+        img = mi.render(scene, seed=seed, spp=a.spp)
         dr.eval(img)
         dr.sync_thread()
         arr = np.array(img, dtype=np.float64)
@@ -150,6 +153,8 @@ def main() -> None:
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--passes", type=int, default=1)
     ap.add_argument("--warm-runs", type=int, default=0)
+    ap.add_argument("--spp", type=int, default=0,
+                    help="samples per pixel for mi.render (0: the scene's sample_count)")
     report = _child(ap.parse_args())
     sys.stdout.flush()
     print(json.dumps(report), flush=True)

@@ -327,6 +327,56 @@ fn checkerboards_and_texture_references() {
     assert!(e.contains("needs an id"), "{e}");
 }
 
+#[test]
+fn textured_spheres_carry_mitsubas_uvs() {
+    // Mitsuba 3.9.1, scalar_rgb: rays towards the centre from five directions; si.p, si.uv.
+    //   sc = mi.load_string(<the shape below, without the bsdf>)
+    //   c = sc.shapes()[0].bbox().center()   # (1.433013, 2.25, 3)
+    //   n = dr.normalize(mi.Vector3f(d)); si = sc.ray_intersect(mi.Ray3f(c + 10*n, -n))
+    let shape = |bsdf: &str| {
+        format!(
+            r#"<shape type="sphere"><point name="center" x="0.5" y="0" z="0"/>
+               <float name="radius" value="2"/>{bsdf}
+               <transform name="to_world"><rotate x="1" angle="90"/><rotate z="1" angle="30"/>
+               <translate x="1" y="2" z="3"/></transform></shape>"#
+        )
+    };
+    let plain = load(&shape("")).desc;
+    assert!(matches!(
+        plain.shapes[0].geometry,
+        GeometryDesc::Sphere { .. }
+    ));
+    let desc = load(&shape(
+        r#"<bsdf type="diffuse"><texture type="checkerboard" name="reflectance"/></bsdf>"#,
+    ))
+    .desc;
+    assert!(matches!(desc.shapes[0].geometry, GeometryDesc::Mesh(_)));
+    let scene = build(&desc).unwrap();
+    let centre = Vec3::new(1.433013, 2.25, 3.0);
+    for (p, uv) in [
+        ([3.314455, 2.814432, 3.376289], [0.030933, 0.42745]),
+        ([0.759291, 3.934304, 3.842152], [0.202567, 0.854803]),
+        ([1.809301, 1.685567, 1.118558], [0.753693, 0.390088]),
+        ([-0.189201, 1.276671, 3.648886], [0.447405, 0.494935]),
+        ([2.007709, 3.782522, 1.850609], [0.88255, 0.674041]),
+    ] {
+        let n = (Vec3::from(p) - centre).normalize();
+        let si = scene
+            .intersect(&Ray::new(centre + 10.0 * n, -n), f32::INFINITY)
+            .expect("hits the sphere");
+        // Tessellated at 1/128 in u, 1/64 in v: within a triangle the uv is linear in the
+        // position, off by second-order terms (< 10⁻³); a mirrored u or a pole on another
+        // axis is off by 0.1 or more.
+        assert!(
+            (si.uv - Vec2::from(uv)).abs().max_element() < 2e-3,
+            "{} vs {uv:?}",
+            si.uv
+        );
+        assert_close(si.p, Vec3::from(p), 2e-3);
+        assert!(si.ns.dot(n) > 0.999, "normal {} at {p:?}", si.ns);
+    }
+}
+
 /// The one light of a scene.
 fn light(body: &str) -> LightKindDesc {
     let desc = load(body).desc;
