@@ -132,7 +132,7 @@ pub fn build(desc: &SceneDesc) -> Result<Scene, BuildError> {
                 let local = match geometry {
                     GeometryDesc::Mesh(m) => {
                         validate_mesh(m, &shape.span)?;
-                        m.clone()
+                        MeshDesc::clone(m)
                     }
                     GeometryDesc::Rectangle => rectangle(),
                     GeometryDesc::Disk => disk(128),

@@ -279,12 +279,11 @@ pub struct ShapeDesc {
 /// imported scenes land where Mitsuba puts them.
 #[derive(Clone, Debug)]
 pub enum GeometryDesc {
-    Mesh(MeshDesc),
+    /// A triangle mesh, shared: shapes that hold the same `Arc` are instances of one mesh
+    /// (a glTF mesh used by several nodes, a Mitsuba `shapegroup`).
+    Mesh(Arc<MeshDesc>),
     /// A sphere; the transform may translate, rotate and scale it uniformly.
-    Sphere {
-        center: Vec3,
-        radius: f32,
-    },
+    Sphere { center: Vec3, radius: f32 },
     /// The square [-1, 1]² in the z = 0 plane, normal +z.
     Rectangle,
     /// The unit disk in the z = 0 plane, normal +z.

@@ -2,6 +2,8 @@
 //! log-uniform over three decades: per-tile means of each sampler's render agree with a
 //! long render of the uniform sampler (Welch's z on tile means), with MIS on.
 
+use std::sync::Arc;
+
 use candela_core::desc::*;
 use candela_core::integrator::li;
 use candela_core::math::luminance;
@@ -81,7 +83,11 @@ fn scene(kind: LightSamplerKind, mis: MisMode, seed: u64) -> candela_core::Scene
                 // Wound so that the normal faces down (towards the floor) for most.
                 d.shapes.push(ShapeDesc {
                     flip_normals: u() < 0.8,
-                    ..shape(GeometryDesc::Mesh(mesh), Mat4::IDENTITY, Some(color * 2.0))
+                    ..shape(
+                        GeometryDesc::Mesh(Arc::new(mesh)),
+                        Mat4::IDENTITY,
+                        Some(color * 2.0),
+                    )
                 });
             }
             1 => d.shapes.push(shape(

@@ -11,6 +11,7 @@
 //! light's emission scaled by 1.05) fails far more tiles than that.
 
 use std::sync::atomic::AtomicBool;
+use std::sync::Arc;
 
 use candela_core::build::build;
 use candela_core::chi2::welch_p_samples;
@@ -86,11 +87,11 @@ fn cornell(mis: MisMode, light_scale: f32) -> SceneDesc {
     }
     for (material, q) in &quads {
         desc.shapes.push(ShapeDesc {
-            geometry: GeometryDesc::Mesh(MeshDesc {
+            geometry: GeometryDesc::Mesh(Arc::new(MeshDesc {
                 positions: q.iter().map(|&p| Vec3::from_array(p)).collect(),
                 indices: vec![[0, 1, 2], [0, 2, 3]],
                 ..Default::default()
-            }),
+            })),
             material: material.to_string(),
             emission: (*material == "light").then(|| Vec3::new(17.0, 12.0, 4.0) * light_scale),
             transform: Mat4::IDENTITY,

@@ -190,7 +190,7 @@ pub(crate) fn parse_shape(
                     ))
                 }
             };
-            (GeometryDesc::Mesh(mesh), common)
+            (GeometryDesc::Mesh(Arc::new(mesh)), common)
         }
         "sphere" => {
             let e: SphereEntry = deserialize(src, item)?;

@@ -3,6 +3,8 @@
 //! [-1,1]³); `obj` and `ply` go through [`crate::load_mesh`]. A textured `sphere`
 //! becomes a mesh carrying Mitsuba's sphere uvs (see [`uv_sphere`]).
 
+use std::sync::Arc;
+
 use candela_core::desc::{BsdfDesc, GeometryDesc, MeshDesc, ShapeDesc, TextureDesc};
 use glam::{Mat4, Vec2, Vec3};
 
@@ -36,7 +38,7 @@ pub(crate) fn shape(ctx: &mut Ctx, node: &Node) -> Result<(), LoadError> {
             {
                 mesh.uvs.iter_mut().for_each(|uv| uv.y = 1.0 - uv.y);
             }
-            GeometryDesc::Mesh(mesh)
+            GeometryDesc::Mesh(Arc::new(mesh))
         }
         _ => {
             return ctx.unsupported(node, format!("<{}> is not supported", describe(node)));
@@ -51,7 +53,7 @@ pub(crate) fn shape(ctx: &mut Ctx, node: &Node) -> Result<(), LoadError> {
     let material = material(ctx, node)?;
     let geometry = match geometry {
         GeometryDesc::Sphere { center, radius } if reads_uv(ctx, &material) => {
-            GeometryDesc::Mesh(uv_sphere(center, radius))
+            GeometryDesc::Mesh(Arc::new(uv_sphere(center, radius)))
         }
         g => g,
     };
