@@ -10,7 +10,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
 
 use candela_core::desc::{
-    ApertureSizeDesc, FocusDesc, LensDesc, LightSamplerKind, MisMode, SceneDesc,
+    ApertureSizeDesc, FocusDesc, LensDesc, LightSamplerKind, MisMode, SamplerKind, SceneDesc,
 };
 use candela_core::integrator;
 use clap::Args;
@@ -96,6 +96,10 @@ pub struct RenderArgs {
     /// Candidates per pick of the `ris` and `ris-bvh` light samplers.
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..))]
     ris_candidates: Option<u32>,
+    /// Sample generator: independent (uniform random numbers) or sobol (Owen-scrambled
+    /// Sobol' points, stratified within each pixel).
+    #[arg(long, value_parser = parse_name::<SamplerKind>)]
+    sampler: Option<SamplerKind>,
     /// Focus distance of a thin lens, in scene units along the view axis (a pinhole
     /// scene also needs --f-number to blur).
     #[arg(long, allow_negative_numbers = true)]
@@ -153,6 +157,7 @@ impl RenderArgs {
         if let Some(n) = self.ris_candidates {
             r.ris_candidates = n;
         }
+        r.sampler = self.sampler.unwrap_or(r.sampler);
         if self.focus_distance.is_some() || self.f_number.is_some() {
             let lens = desc.camera.lens.get_or_insert_with(LensDesc::default);
             if let Some(d) = self.focus_distance {

@@ -515,6 +515,18 @@ pub enum LightSamplerKind {
     RisBvh,
 }
 
+/// Where the integrator's uniform numbers come from (see [`crate::sampler`]). Its names in
+/// scene files and on the command line are `independent` and `sobol`.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum SamplerKind {
+    /// Independent uniform numbers (PCG32).
+    #[default]
+    Independent,
+    /// Owen-scrambled Sobol' points, stratified within each pixel.
+    Sobol,
+}
+
 /// Default number of RIS candidates, chosen by `bench/many_lights`.
 pub const DEFAULT_RIS_CANDIDATES: u32 = 2;
 
@@ -532,6 +544,7 @@ pub struct RenderSettings {
     pub light_sampler: LightSamplerKind,
     /// Candidates per pick of the RIS light samplers.
     pub ris_candidates: u32,
+    pub sampler: SamplerKind,
     /// Camera rays that hit an emitter or escape to the environment return nothing at
     /// all, as with Mitsuba's `hide_emitters` (the emitters still light the scene).
     pub hide_emitters: bool,
@@ -565,6 +578,7 @@ impl Default for RenderSettings {
             mis: MisMode::default(),
             light_sampler: LightSamplerKind::default(),
             ris_candidates: DEFAULT_RIS_CANDIDATES,
+            sampler: SamplerKind::default(),
             hide_emitters: false,
             filter: PixelFilterDesc::Box,
         }

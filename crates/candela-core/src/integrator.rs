@@ -9,13 +9,13 @@ use glam::{UVec2, Vec2, Vec3};
 use rayon::prelude::*;
 
 use crate::bsdf::Bsdf;
-use crate::desc::MisMode;
+use crate::desc::{MisMode, SamplerKind};
 use crate::film::{Film, Pixel};
 use crate::filter::PixelFilter;
 use crate::geometry::Ray;
 use crate::light::{LightId, ShadingCtx};
 use crate::math::max_component;
-use crate::sampler::{IndependentSampler, Sampler};
+use crate::sampler::{IndependentSampler, Sampler, SobolSampler};
 use crate::sampling::{balance_heuristic, power_heuristic};
 use crate::scene::{Scene, SurfaceInteraction};
 
@@ -57,9 +57,32 @@ pub struct RenderResult {
 /// Works in passes of a few samples over the whole image; between work items it checks
 /// `cancel`, and after each item it reports the number of pixel samples done to
 /// `progress`. The result depends only on the scene, its seed and the range: not on the
-/// thread count or the order of work.
+/// thread count or the order of work. The scene's [`SamplerKind`] chooses the sampler.
 pub fn render(
     scene: &Scene,
+    samples: Range<u32>,
+    cancel: &AtomicBool,
+    progress: &(dyn Fn(u64) + Sync),
+) -> RenderResult {
+    let seed = scene.settings.seed;
+    match scene.settings.sampler {
+        SamplerKind::Independent => render_with(
+            scene,
+            IndependentSampler::new(seed),
+            samples,
+            cancel,
+            progress,
+        ),
+        SamplerKind::Sobol => {
+            render_with(scene, SobolSampler::new(seed), samples, cancel, progress)
+        }
+    }
+}
+
+/// [`render`] with a given sampler, monomorphized so that no sample is a dynamic call.
+pub fn render_with<S: Sampler>(
+    scene: &Scene,
+    sampler: S,
     samples: Range<u32>,
     cancel: &AtomicBool,
     progress: &(dyn Fn(u64) + Sync),
@@ -69,7 +92,6 @@ pub fn render(
     let spp = samples.len() as u32;
     let pass_spp = (spp / 16).clamp(1, 8);
     let mut stats = RenderStats::default();
-    let sampler = IndependentSampler::new(scene.settings.seed);
     let mut start = samples.start;
     while start < samples.end && !cancel.load(Ordering::Relaxed) {
         let pass = start..(start + pass_spp).min(samples.end);

@@ -10,7 +10,8 @@
 use std::path::Path;
 
 use candela_core::desc::{
-    EmissionProfileDesc, LightSamplerKind, MaterialDesc, MisMode, RenderSettings, SceneDesc,
+    EmissionProfileDesc, LightSamplerKind, MaterialDesc, MisMode, RenderSettings, SamplerKind,
+    SceneDesc,
 };
 use serde::de::DeserializeOwned;
 use serde::Deserialize;
@@ -151,6 +152,7 @@ struct RenderSection {
     mis: Option<MisMode>,
     light_sampler: Option<LightSamplerKind>,
     ris_candidates: Option<std::num::NonZeroU32>,
+    sampler: Option<SamplerKind>,
 }
 
 fn parse_render(src: &Source, value: Item) -> Result<RenderSettings, LoadError> {
@@ -167,6 +169,7 @@ fn parse_render(src: &Source, value: Item) -> Result<RenderSettings, LoadError> 
     if let Some(n) = r.ris_candidates {
         out.ris_candidates = n.get();
     }
+    out.sampler = r.sampler.unwrap_or(out.sampler);
     Ok(out)
 }
 

@@ -6,8 +6,16 @@
 //! thin lens only, the lens point (2D). Then, per bounce, the integrator takes its
 //! dimensions in a fixed order: light pick (1D), light point (2D), BSDF lobe (1D), BSDF
 //! direction (2D), Russian roulette (1D). A low-discrepancy sampler can rely on that order.
+//!
+//! Two samplers: [`IndependentSampler`] (uniform random numbers) and [`SobolSampler`]
+//! (Owen-scrambled Sobol' points, stratified within each pixel). The integrator picks one
+//! by [`crate::desc::SamplerKind`] and is monomorphized for each, so no call is dynamic.
+
+mod sobol;
 
 use glam::{UVec2, Vec2};
+
+pub use sobol::{owen_scramble, sobol_2d, SobolSampler};
 
 /// A source of uniform numbers in [0, 1) for one pixel sample at a time.
 pub trait Sampler: Send + Sync + Clone {

@@ -1,0 +1,223 @@
+//! The Sobol' sampler's two promises: within a pixel its samples are stratified, and
+//! across pixels (and across requests of one pixel sample) they are independent uniform
+//! numbers, like the independent sampler's.
+//!
+//! Stratification is exact, so its checks are counts: for 2ᵏ samples of one pixel, every
+//! 1D request has exactly one point in each of the 2ᵏ intervals [j/2ᵏ, (j+1)/2ᵏ), and
+//! every 2D request is a (0, k, 2)-net, exactly one point in every elementary interval of
+//! area 2⁻ᵏ (all 2ᵃ × 2ᵇ grids with a + b = k). The independent sampler fails the same
+//! check, so it can fail.
+//!
+//! Uniformity is statistical: 10⁶ pixels at one sample index give 10⁶ points, histogrammed
+//! on 32 × 32 cells by the chi-square harness, α = 0.01 over all the chi-square tests of
+//! this file with Šidák's correction. A pair of consecutive sample indices of one pixel is
+//! *not* uniform on the square (the pair is stratified), and the same test rejects it.
+
+use candela_core::chi2::{sidak_alpha, ChiSquareTest};
+use candela_core::sampler::{IndependentSampler, Sampler, SobolSampler};
+use glam::{UVec2, Vec2};
+
+/// One request of a pixel sample: `skip` 2D requests first, then a 1D or 2D one.
+#[derive(Clone, Copy, Debug)]
+enum Request {
+    OneD { skip: u32 },
+    TwoD { skip: u32 },
+}
+
+fn draw<S: Sampler>(s: &mut S, pixel: UVec2, index: u32, req: Request) -> Vec2 {
+    s.start_pixel_sample(pixel, index);
+    match req {
+        Request::OneD { skip } => {
+            (0..skip).for_each(|_| {
+                s.get_2d();
+            });
+            Vec2::new(s.get_1d(), 0.0)
+        }
+        Request::TwoD { skip } => {
+            (0..skip).for_each(|_| {
+                s.get_2d();
+            });
+            s.get_2d()
+        }
+    }
+}
+
+/// Whether the points are a (0, k, 2)-net (2D) or a one-per-stratum set (1D), k = log2 n.
+fn is_stratified(points: &[Vec2], two_d: bool) -> bool {
+    let n = points.len();
+    assert!(n.is_power_of_two());
+    let k = n.trailing_zeros();
+    let splits: Vec<(u32, u32)> = if two_d {
+        (0..=k).map(|a| (a, k - a)).collect()
+    } else {
+        vec![(k, 0)]
+    };
+    splits.into_iter().all(|(a, b)| {
+        let mut seen = vec![false; n];
+        points.iter().all(|p| {
+            let ix = (p.x as f64 * (1u64 << a) as f64) as usize;
+            let iy = (p.y as f64 * (1u64 << b) as f64) as usize;
+            let cell = (iy << a) | ix;
+            !std::mem::replace(&mut seen[cell], true)
+        })
+    })
+}
+
+fn points<S: Sampler>(
+    s: &mut S,
+    pixel: UVec2,
+    indices: std::ops::Range<u32>,
+    req: Request,
+) -> Vec<Vec2> {
+    indices.map(|i| draw(s, pixel, i, req)).collect()
+}
+
+const REQUESTS: [Request; 6] = [
+    Request::TwoD { skip: 0 },
+    Request::OneD { skip: 0 },
+    Request::TwoD { skip: 1 },
+    Request::OneD { skip: 3 },
+    Request::TwoD { skip: 7 },
+    Request::TwoD { skip: 40 },
+];
+
+#[test]
+fn every_request_of_2k_samples_is_stratified() {
+    let mut checked = 0;
+    for seed in [0u64, 1, 12345] {
+        let mut s = SobolSampler::new(seed);
+        for pixel in [UVec2::new(0, 0), UVec2::new(17, 3), UVec2::new(511, 511)] {
+            for req in REQUESTS {
+                let two_d = matches!(req, Request::TwoD { .. });
+                for k in 0..=12u32 {
+                    let n = 1u32 << k;
+                    // The first 2ᵏ samples, and an aligned later block (a render of the
+                    // sample range [3·2ᵏ, 4·2ᵏ)).
+                    for start in [0, 3 * n] {
+                        let p = points(&mut s, pixel, start..start + n, req);
+                        assert!(
+                            is_stratified(&p, two_d),
+                            "seed {seed}, pixel {pixel}, {req:?}, samples {start}..{}",
+                            start + n
+                        );
+                        checked += 1;
+                    }
+                }
+            }
+        }
+    }
+    eprintln!("{checked} sample sets stratified");
+}
+
+#[test]
+fn a_sample_count_that_is_no_power_of_two_is_a_union_of_nets() {
+    // 12 = 8 + 4: samples 0..8 are a net of 8 and samples 8..12 a net of 4 (see the
+    // sampler's docs); 1000 = 512 + 256 + 128 + 64 + 32 + 8 likewise.
+    let mut s = SobolSampler::new(9);
+    for req in REQUESTS {
+        let two_d = matches!(req, Request::TwoD { .. });
+        for (n, pixel) in [(12u32, UVec2::new(5, 6)), (1000, UVec2::new(40, 2))] {
+            let mut start = 0;
+            for bit in (0..32).rev().filter(|b| n & (1 << b) != 0) {
+                let p = points(&mut s, pixel, start..start + (1 << bit), req);
+                assert!(
+                    is_stratified(&p, two_d),
+                    "{req:?}, n = {n}, block at {start}"
+                );
+                start += 1 << bit;
+            }
+        }
+    }
+}
+
+#[test]
+fn the_stratification_check_rejects_independent_samples() {
+    // Independent points are a (0, k, 2)-net by chance with probability n!/nⁿ per split:
+    // already 1.6·10⁻¹⁰ at n = 32 — the check above could not pass by luck.
+    let mut s = IndependentSampler::new(0);
+    for req in REQUESTS {
+        let two_d = matches!(req, Request::TwoD { .. });
+        let p = points(&mut s, UVec2::new(17, 3), 0..32, req);
+        assert!(!is_stratified(&p, two_d), "{req:?}");
+    }
+}
+
+/// Chi-square tests in this file, for the Šidák correction.
+const CHI2_TESTS: usize = 6;
+
+fn chi2_over_pixels(
+    name: &str,
+    mut point: impl FnMut(UVec2) -> Vec2,
+) -> candela_core::chi2::Chi2Report {
+    let test = ChiSquareTest {
+        alpha: sidak_alpha(0.01, CHI2_TESTS),
+        ..Default::default()
+    };
+    let mut k = 0u32;
+    test.planar(
+        name,
+        Vec2::ZERO,
+        Vec2::ONE,
+        |_| {
+            let pixel = UVec2::new(k % 1000, k / 1000);
+            k += 1;
+            Some(point(pixel))
+        },
+        |_| 1.0,
+    )
+}
+
+#[test]
+fn across_pixels_every_request_is_uniform() {
+    let mut s = SobolSampler::new(4);
+    for (index, req) in [
+        (0u32, Request::TwoD { skip: 0 }),
+        (5, Request::TwoD { skip: 7 }),
+        (77, Request::TwoD { skip: 40 }),
+    ] {
+        let report = chi2_over_pixels(&format!("sample {index}, {req:?}"), |p| {
+            draw(&mut s, p, index, req)
+        });
+        eprintln!("sample {index}, {req:?}: p = {:.3}", report.p_value);
+        report.assert_passed();
+    }
+}
+
+#[test]
+fn across_pixels_two_requests_are_independent() {
+    // The first coordinate of two different requests of one pixel sample (and a 1D
+    // request against a 2D one): padding must leave no correlation between them.
+    let mut s = SobolSampler::new(5);
+    for (a, b) in [(0u32, 1u32), (2, 9)] {
+        let report = chi2_over_pixels(&format!("requests {a} and {b}"), |p| {
+            let x = draw(&mut s, p, 3, Request::TwoD { skip: a }).x;
+            let y = draw(&mut s, p, 3, Request::OneD { skip: b }).x;
+            Vec2::new(x, y)
+        });
+        eprintln!("requests {a}, {b}: p = {:.3}", report.p_value);
+        report.assert_passed();
+    }
+}
+
+#[test]
+fn consecutive_samples_of_a_pixel_are_stratified_not_independent() {
+    // Samples 2j and 2j+1 of one pixel fall in opposite halves of [0, 1): their pair is
+    // far from uniform on the square, and the chi-square test sees it. The independent
+    // sampler's pair is uniform.
+    let req = Request::OneD { skip: 2 };
+    let mut sobol = SobolSampler::new(6);
+    let report = chi2_over_pixels("Sobol', samples 6 and 7", |p| {
+        Vec2::new(draw(&mut sobol, p, 6, req).x, draw(&mut sobol, p, 7, req).x)
+    });
+    eprintln!("Sobol' pair: p = {:.3e}", report.p_value);
+    assert!(!report.passed(), "the stratified pair looked independent");
+    let mut independent = IndependentSampler::new(6);
+    let report = chi2_over_pixels("independent, samples 6 and 7", |p| {
+        Vec2::new(
+            draw(&mut independent, p, 6, req).x,
+            draw(&mut independent, p, 7, req).x,
+        )
+    });
+    eprintln!("independent pair: p = {:.3}", report.p_value);
+    report.assert_passed();
+}
