@@ -8,6 +8,10 @@
 //! ~10⁴ pixels checked in all). Where a scene has
 //! no variance at all (the furnace with BSDF sampling), a floor of 10⁻⁴·L covers f32
 //! round-off.
+//!
+//! Every scene is rendered with both samplers: the Sobol' sampler's pixels are as
+//! independent of each other as the independent sampler's (each pixel has its own
+//! scrambles), so the same bounds apply to it.
 
 use std::sync::atomic::AtomicBool;
 
@@ -22,6 +26,8 @@ const MIS_MODES: [MisMode; 4] = [
     MisMode::NeeOnly,
     MisMode::BsdfOnly,
 ];
+
+const SAMPLERS: [SamplerKind; 2] = [SamplerKind::Independent, SamplerKind::Sobol];
 
 fn material(name: &str, albedo: f32) -> MaterialDesc {
     MaterialDesc {
@@ -44,8 +50,15 @@ fn shape(geometry: GeometryDesc, material: &str, le: Option<f32>, flip: bool) ->
     }
 }
 
-fn settings(mis: MisMode, max_depth: u32, spp: u32, seed: u64) -> RenderSettings {
+fn settings(
+    sampler: SamplerKind,
+    mis: MisMode,
+    max_depth: u32,
+    spp: u32,
+    seed: u64,
+) -> RenderSettings {
     RenderSettings {
+        sampler,
         width: 32,
         height: 32,
         spp,
@@ -106,11 +119,14 @@ fn closed_emitting_sphere_has_radiance_le_over_one_minus_albedo() {
     // L = Le + ρL, so L = Le/(1−ρ) (paths unlimited; Russian roulette ends them).
     // 32×32 pixels at 64 spp.
     let le = 0.7;
-    for rho in [0.5f32, 0.8] {
+    for (rho, sampler) in [0.5f32, 0.8]
+        .into_iter()
+        .flat_map(|r| SAMPLERS.map(|s| (r, s)))
+    {
         for mis in MIS_MODES {
             let mut desc = SceneDesc {
                 camera: inside_camera(Vec3::new(0.2, -0.1, 0.3), Vec3::new(0.0, 0.4, -1.0)),
-                render: settings(mis, 1000, 64, 17),
+                render: settings(sampler, mis, 1000, 64, 17),
                 ..Default::default()
             };
             desc.materials.push(material("wall", rho));
@@ -125,7 +141,7 @@ fn closed_emitting_sphere_has_radiance_le_over_one_minus_albedo() {
             ));
             let expected = le as f64 / (1.0 - rho as f64);
             check_uniform(
-                &format!("sphere ρ = {rho}, {mis:?}"),
+                &format!("sphere ρ = {rho}, {mis:?}, {sampler:?}"),
                 &render_pixels(&desc),
                 expected,
                 true,
@@ -139,7 +155,10 @@ fn furnace_box_with_max_depth_n_has_radiance_n_plus_one_le() {
     // An inward cube of albedo 1 emitting Le everywhere: each of the N scattering events
     // a path may take adds exactly Le to what the eye sees, so L = (N+1)·Le.
     let le = 0.25;
-    for max_depth in [0u32, 1, 3, 6] {
+    for (max_depth, sampler) in [0u32, 1, 3, 6]
+        .into_iter()
+        .flat_map(|d| SAMPLERS.map(|s| (d, s)))
+    {
         for mis in MIS_MODES {
             let mut desc = SceneDesc {
                 // The camera sees the middle of one face (see the per-pixel note below).
@@ -147,7 +166,7 @@ fn furnace_box_with_max_depth_n_has_radiance_n_plus_one_le() {
                     fov_y_deg: 40.0,
                     ..inside_camera(Vec3::new(0.1, -0.05, 0.2), Vec3::new(0.1, -0.05, -1.0))
                 },
-                render: settings(mis, max_depth, 32, 23),
+                render: settings(sampler, mis, max_depth, 32, 23),
                 ..Default::default()
             };
             desc.materials.push(material("white", 1.0));
@@ -155,7 +174,7 @@ fn furnace_box_with_max_depth_n_has_radiance_n_plus_one_le() {
                 .push(shape(GeometryDesc::Cube, "white", Some(le), true));
             let expected = (max_depth + 1) as f64 * le as f64;
             check_uniform(
-                &format!("furnace, max_depth {max_depth}, {mis:?}"),
+                &format!("furnace, max_depth {max_depth}, {mis:?}, {sampler:?}"),
                 &render_pixels(&desc),
                 expected,
                 // Paths reach points near the cube's concave edges, where next event
@@ -178,12 +197,15 @@ fn sphere_enclosure_around_a_black_emitter_conserves_energy() {
     // At ρ = 1 every watt emitted returns to the emitter and L_w = Le exactly.
     let (le, r) = (2.0f32, 0.3f32);
     let k = (r * r) as f64;
-    for rho in [1.0f32, 0.7] {
+    for (rho, sampler) in [1.0f32, 0.7]
+        .into_iter()
+        .flat_map(|r| SAMPLERS.map(|s| (r, s)))
+    {
         for mis in [MisMode::Balance, MisMode::BsdfOnly] {
             let mut desc = SceneDesc {
                 // Looking away from the emitter, so that every pixel sees the wall.
                 camera: inside_camera(Vec3::new(0.0, 0.0, 0.5), Vec3::new(0.0, 0.0, 1.0)),
-                render: settings(mis, 1000, 64, 29),
+                render: settings(sampler, mis, 1000, 64, 29),
                 ..Default::default()
             };
             desc.materials.push(material("wall", rho));
@@ -209,7 +231,7 @@ fn sphere_enclosure_around_a_black_emitter_conserves_energy() {
             let rho64 = rho as f64;
             let expected = rho64 * le as f64 * k / (1.0 - rho64 * (1.0 - k));
             check_uniform(
-                &format!("sphere enclosure ρ = {rho}, {mis:?}"),
+                &format!("sphere enclosure ρ = {rho}, {mis:?}, {sampler:?}"),
                 &render_pixels(&desc),
                 expected,
                 true,
@@ -220,7 +242,14 @@ fn sphere_enclosure_around_a_black_emitter_conserves_energy() {
 
 /// Radiance of a diffuse plane y = 0 (albedo ρ) at `target` on it, lit by a point light
 /// of intensity `intensity` at height `h` over the origin, seen by a narrow camera.
-fn plane_radiance(rho: f32, intensity: f32, h: f32, target: Vec3, mis: MisMode) -> f64 {
+fn plane_radiance(
+    rho: f32,
+    intensity: f32,
+    h: f32,
+    target: Vec3,
+    mis: MisMode,
+    sampler: SamplerKind,
+) -> f64 {
     let mut desc = SceneDesc {
         camera: CameraDesc {
             position: target + Vec3::new(0.3, 2.0, 0.2),
@@ -234,7 +263,7 @@ fn plane_radiance(rho: f32, intensity: f32, h: f32, target: Vec3, mis: MisMode) 
         render: RenderSettings {
             width: 4,
             height: 4,
-            ..settings(mis, 1, 4, 5)
+            ..settings(sampler, mis, 1, 4, 5)
         },
         ..Default::default()
     };
@@ -260,21 +289,21 @@ fn point_light_over_a_diffuse_plane() {
     // Direct light only (max_depth 1): L = ρ/π · I·cos θ/d². Every sample is exact, so
     // the tolerance 10⁻³ (relative) covers only the f32 arithmetic and the footprint.
     let (rho, intensity, h) = (0.6f32, 5.0f32, 1.5f32);
-    for mis in MIS_MODES {
-        let foot = plane_radiance(rho, intensity, h, Vec3::ZERO, mis);
+    for (mis, sampler) in MIS_MODES.into_iter().flat_map(|m| SAMPLERS.map(|s| (m, s))) {
+        let foot = plane_radiance(rho, intensity, h, Vec3::ZERO, mis, sampler);
         let expected = rho as f64 / std::f64::consts::PI * intensity as f64 / (h * h) as f64;
         assert!(
             (foot / expected - 1.0).abs() < 1e-3,
-            "{mis:?}: foot {foot} vs {expected}"
+            "{mis:?}, {sampler:?}: foot {foot} vs {expected}"
         );
         let x = Vec3::new(1.2, 0.0, -0.7);
-        let off = plane_radiance(rho, intensity, h, x, mis);
+        let off = plane_radiance(rho, intensity, h, x, mis, sampler);
         let d2 = (x.length_squared() + h * h) as f64;
         let cos = h as f64 / d2.sqrt();
         let expected = rho as f64 / std::f64::consts::PI * intensity as f64 * cos / d2;
         assert!(
             (off / expected - 1.0).abs() < 1e-3,
-            "{mis:?}: offset {off} vs {expected}"
+            "{mis:?}, {sampler:?}: offset {off} vs {expected}"
         );
     }
 }

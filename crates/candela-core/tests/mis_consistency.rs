@@ -8,7 +8,9 @@
 //! balance heuristic. α = 0.001 per tile; with 64 independent tiles per comparison the
 //! number of false rejections is Binomial(64, 0.001), and P(X ≥ 3) ≈ 4·10⁻⁵, so up to 2
 //! failing tiles are allowed per comparison. A second test shows that a 5% bias (the
-//! light's emission scaled by 1.05) fails far more tiles than that.
+//! light's emission scaled by 1.05) fails far more tiles than that. The same comparison
+//! checks the Sobol' sampler against the independent one (both with the balance
+//! heuristic): a sampler that is not uniform biases the image.
 
 use std::sync::atomic::AtomicBool;
 use std::sync::Arc;
@@ -103,12 +105,18 @@ fn cornell(mis: MisMode, light_scale: f32) -> SceneDesc {
 }
 
 /// Per tile, the tile's mean luminance in each of the independent renders.
-fn tile_means(mis: MisMode, light_scale: f32, seed_base: u64) -> Vec<Vec<f64>> {
+fn tile_means(
+    mis: MisMode,
+    sampler: SamplerKind,
+    light_scale: f32,
+    seed_base: u64,
+) -> Vec<Vec<f64>> {
     let tiles = (RES / TILE) as usize;
     let mut out = vec![Vec::new(); tiles * tiles];
     for k in 0..RENDERS {
         let mut desc = cornell(mis, light_scale);
         desc.render.seed = seed_base + k;
+        desc.render.sampler = sampler;
         let scene = build(&desc).expect("Cornell box builds");
         let film = render(&scene, 0..SPP, &AtomicBool::new(false), &|_| {}).film;
         let img = film.resolve();
@@ -137,13 +145,13 @@ fn failing_tiles(a: &[Vec<f64>], b: &[Vec<f64>]) -> Vec<(usize, f64)> {
 #[test]
 #[ignore = "slow statistical test; CI runs it"]
 fn mis_modes_agree_on_the_cornell_box() {
-    let balance = tile_means(MisMode::Balance, 1.0, 1000);
+    let balance = tile_means(MisMode::Balance, SamplerKind::Independent, 1.0, 1000);
     for (mis, seed) in [
         (MisMode::Power, 2000),
         (MisMode::NeeOnly, 3000),
         (MisMode::BsdfOnly, 4000),
     ] {
-        let other = tile_means(mis, 1.0, seed);
+        let other = tile_means(mis, SamplerKind::Independent, 1.0, seed);
         let fails = failing_tiles(&balance, &other);
         eprintln!(
             "{mis:?} vs Balance: {} of 64 tiles fail at α = {ALPHA}",
@@ -161,13 +169,29 @@ fn mis_modes_agree_on_the_cornell_box() {
 fn a_five_percent_bias_is_detected() {
     // The same comparison against a render whose light is 5% brighter: the test above
     // must be able to fail.
-    let balance = tile_means(MisMode::Balance, 1.0, 1000);
-    let brighter = tile_means(MisMode::NeeOnly, 1.05, 3000);
+    let balance = tile_means(MisMode::Balance, SamplerKind::Independent, 1.0, 1000);
+    let brighter = tile_means(MisMode::NeeOnly, SamplerKind::Independent, 1.05, 3000);
     let fails = failing_tiles(&balance, &brighter);
     eprintln!("light × 1.05: {} of 64 tiles fail", fails.len());
     assert!(
         fails.len() > 8 * ALLOWED_FAILURES,
         "only {} tiles detect the bias",
         fails.len()
+    );
+}
+
+#[test]
+#[ignore = "slow statistical test; CI runs it"]
+fn sobol_agrees_with_the_independent_sampler_on_the_cornell_box() {
+    let independent = tile_means(MisMode::Balance, SamplerKind::Independent, 1.0, 1000);
+    let sobol = tile_means(MisMode::Balance, SamplerKind::Sobol, 1.0, 5000);
+    let fails = failing_tiles(&independent, &sobol);
+    eprintln!(
+        "Sobol' vs independent: {} of 64 tiles fail at α = {ALPHA}",
+        fails.len()
+    );
+    assert!(
+        fails.len() <= ALLOWED_FAILURES,
+        "the Sobol' sampler disagrees with the independent one in tiles (index, p) {fails:?}"
     );
 }

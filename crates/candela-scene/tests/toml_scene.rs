@@ -5,7 +5,8 @@ use std::fs;
 use std::path::Path;
 
 use candela_core::desc::{
-    BsdfDesc, GeometryDesc, LightKindDesc, LightSamplerKind, MisMode, SceneDesc, Span, TextureDesc,
+    BsdfDesc, GeometryDesc, LightKindDesc, LightSamplerKind, MisMode, SamplerKind, SceneDesc, Span,
+    TextureDesc,
 };
 use candela_scene::{load_scene, parse_toml_scene};
 use glam::{Mat4, Vec3};
@@ -73,6 +74,18 @@ fn render_settings_and_camera() {
             mode
         );
     }
+    for (name, kind) in [
+        ("independent", SamplerKind::Independent),
+        ("sobol", SamplerKind::Sobol),
+    ] {
+        let r = parse(&format!("[render]\nsampler = \"{name}\"")).render;
+        assert_eq!(r.sampler, kind);
+    }
+    let bad = parse_toml_scene("[render]\nsampler = \"halton\"\n", Path::new("scene.toml"));
+    assert_eq!(
+        bad.unwrap_err().to_string(),
+        "scene.toml:2:11: unknown variant `halton`, expected `independent` or `sobol`"
+    );
     // Defaults when the sections are absent.
     let d = parse("");
     assert_eq!(
