@@ -49,15 +49,47 @@ const SOBOL_DIM1: [u32; 32] = {
     c
 };
 
+/// The second dimension's matrix in bit-reversed form, by bytes of the index:
+/// `SOBOL_DIM1_REV[k][b]` is the bit reversal of the point of index `b << 8k`, so a point
+/// is four lookups xored instead of a loop over the index's set bits.
+const SOBOL_DIM1_REV: [[u32; 256]; 4] = {
+    let mut t = [[0u32; 256]; 4];
+    let mut k = 0;
+    while k < 4 {
+        let mut b = 0;
+        while b < 256 {
+            let mut v = 0u32;
+            let mut j = 0;
+            while j < 8 {
+                if b & (1 << j) != 0 {
+                    v ^= SOBOL_DIM1[8 * k + j].reverse_bits();
+                }
+                j += 1;
+            }
+            t[k][b] = v;
+            b += 1;
+        }
+        k += 1;
+    }
+    t
+};
+
 /// Point `index` of the first two Sobol' dimensions, as 32-bit fractions.
 pub fn sobol_2d(index: u32) -> (u32, u32) {
-    let mut y = 0u32;
-    let mut bits = index;
-    while bits != 0 {
-        y ^= SOBOL_DIM1[bits.trailing_zeros() as usize];
-        bits &= bits - 1;
-    }
-    (index.reverse_bits(), y)
+    (
+        index.reverse_bits(),
+        sobol_dim1_reversed(index).reverse_bits(),
+    )
+}
+
+/// The second coordinate of point `index`, bit-reversed.
+#[inline]
+fn sobol_dim1_reversed(index: u32) -> u32 {
+    let b = index.to_le_bytes();
+    SOBOL_DIM1_REV[0][b[0] as usize]
+        ^ SOBOL_DIM1_REV[1][b[1] as usize]
+        ^ SOBOL_DIM1_REV[2][b[2] as usize]
+        ^ SOBOL_DIM1_REV[3][b[3] as usize]
 }
 
 /// A nested uniform (Owen) scramble of a 32-bit fraction by a hash: each bit is flipped by
@@ -67,13 +99,19 @@ pub fn sobol_2d(index: u32) -> (u32, u32) {
 /// bit only as a function of the bits below it, so the whole is a nested scramble: it
 /// maps each dyadic interval of length 2⁻ᵏ onto another.
 pub fn owen_scramble(v: u32, seed: u32) -> u32 {
-    let mut v = v.reverse_bits();
+    scramble_reversed(v.reverse_bits(), seed).reverse_bits()
+}
+
+/// [`owen_scramble`] on bit-reversed input and output (the sampler keeps values reversed
+/// where it can, to save reversals).
+#[inline]
+fn scramble_reversed(mut v: u32, seed: u32) -> u32 {
     v ^= v.wrapping_mul(0x3d20_adea);
     v = v.wrapping_add(seed);
     v = v.wrapping_mul((seed >> 16) | 1);
     v ^= v.wrapping_mul(0x0552_6c56);
     v ^= v.wrapping_mul(0x53a2_2864);
-    v.reverse_bits()
+    v
 }
 
 /// The top 24 bits of a fraction as a float in [0, 1), exactly.
@@ -89,7 +127,8 @@ pub struct SobolSampler {
     seed: u64,
     /// Hash of (seed, pixel) for the current pixel sample.
     pixel_key: u64,
-    index: u32,
+    /// The sample index, bit-reversed.
+    index_reversed: u32,
     /// Requests taken so far in this pixel sample (a 2D request counts two).
     dimension: u32,
 }
@@ -99,39 +138,55 @@ impl SobolSampler {
         SobolSampler {
             seed,
             pixel_key: 0,
-            index: 0,
+            index_reversed: 0,
             dimension: 0,
         }
     }
 
-    /// Independent 64-bit hashes for the next request, and the request's shuffled index.
+    /// The next request's hash (splitmix64's sequence from the pixel's key) and its
+    /// shuffled index `owen_scramble(index, low half of the hash)`.
+    #[inline]
     fn next_request(&mut self, width: u32) -> (u32, u64) {
-        let h = mix64(self.pixel_key ^ mix64(self.dimension as u64));
+        const GOLDEN: u64 = 0x9e37_79b9_7f4a_7c15;
+        let h = mix64(
+            self.pixel_key
+                .wrapping_add((self.dimension as u64).wrapping_mul(GOLDEN)),
+        );
         self.dimension += width;
-        (owen_scramble(self.index, h as u32), mix64(h))
+        let shuffled = scramble_reversed(self.index_reversed, h as u32).reverse_bits();
+        (shuffled, h)
     }
+}
+
+/// The third 32-bit seed of a 2D request from its 64-bit hash: the high half of an odd
+/// multiple (a multiply is cheaper than a second finalizer, and the hash is already mixed).
+#[inline]
+fn y_seed(h: u64) -> u32 {
+    (h.wrapping_mul(0xd134_2543_de82_ef95) >> 32) as u32
 }
 
 impl Sampler for SobolSampler {
     fn start_pixel_sample(&mut self, pixel: UVec2, index: u32) {
         let key = ((pixel.x as u64) << 32) | pixel.y as u64;
         self.pixel_key = mix64(self.seed ^ mix64(key));
-        self.index = index;
+        self.index_reversed = index.reverse_bits();
         self.dimension = 0;
     }
 
+    #[inline]
     fn get_1d(&mut self) -> f32 {
+        // The first coordinate of point i is reverse(i); its scramble works on reverse of
+        // that, i itself.
         let (i, h) = self.next_request(1);
-        to_unit(owen_scramble(i.reverse_bits(), h as u32))
+        to_unit(scramble_reversed(i, (h >> 32) as u32).reverse_bits())
     }
 
+    #[inline]
     fn get_2d(&mut self) -> Vec2 {
         let (i, h) = self.next_request(2);
-        let (x, y) = sobol_2d(i);
-        Vec2::new(
-            to_unit(owen_scramble(x, h as u32)),
-            to_unit(owen_scramble(y, (h >> 32) as u32)),
-        )
+        let x = scramble_reversed(i, (h >> 32) as u32).reverse_bits();
+        let y = scramble_reversed(sobol_dim1_reversed(i), y_seed(h)).reverse_bits();
+        Vec2::new(to_unit(x), to_unit(y))
     }
 }
 
@@ -169,6 +224,37 @@ mod tests {
             let (sa, sb) = (owen_scramble(a, seed), owen_scramble(b, seed));
             assert_eq!(sa & mask, sb & mask, "k = {k}");
         }
+    }
+
+    #[test]
+    fn table_lookup_equals_the_generator_matrix() {
+        let mut rng = super::super::Pcg32::new(1, 2);
+        for i in (0..4096).chain((0..4096).map(|_| rng.next_u32())) {
+            let mut y = 0u32;
+            for (bit, column) in SOBOL_DIM1.iter().enumerate() {
+                if i & (1 << bit) != 0 {
+                    y ^= column;
+                }
+            }
+            assert_eq!(sobol_2d(i).1, y, "index {i}");
+        }
+    }
+
+    #[test]
+    fn the_sampler_is_the_documented_composition() {
+        // 2D request d of sample i: shuffle i, take Sobol' point, scramble each coordinate.
+        let mut s = SobolSampler::new(3);
+        s.start_pixel_sample(UVec2::new(8, 9), 37);
+        let key = s.pixel_key;
+        s.get_1d();
+        let got = s.get_2d();
+        let h = mix64(key.wrapping_add(0x9e37_79b9_7f4a_7c15));
+        let (x, y) = sobol_2d(owen_scramble(37, h as u32));
+        let want = Vec2::new(
+            to_unit(owen_scramble(x, (h >> 32) as u32)),
+            to_unit(owen_scramble(y, y_seed(h))),
+        );
+        assert_eq!(got, want);
     }
 
     #[test]
