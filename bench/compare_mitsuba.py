@@ -185,6 +185,8 @@ def run_candela(scene: str, out: str, params: dict, a, seed: int) -> dict:
     defines = [x for k, v in params.items() for x in ("-D", f"{k}={v}")]
     cmd = [CANDELA, "render", scene, "-o", out, "--threads", str(a.threads),
            "--seed", str(seed), "--spp", str(a.spp)] + defines
+    if a.sampler:
+        cmd += ["--sampler", a.sampler]
     c0 = candela._children_cpu_s()
     p = subprocess.run(cmd, cwd=REPO, capture_output=True, text=True)
     if p.returncode != 0:
@@ -307,6 +309,8 @@ def main() -> None:
                     "(default); file: the file's own filter")
     ap.add_argument("--variants", default="llvm_ad_rgb,scalar_rgb")
     ap.add_argument("--skip-build", action="store_true")
+    ap.add_argument("--sampler", choices=["independent", "sobol"],
+                    help="Candela's --sampler (default: what the XML's <sampler> maps to)")
     ap.add_argument("--measure-equal-time", action="store_true",
                     help="also render each Mitsuba variant once at the spp that takes "
                     "Candela's time, to check the extrapolated equal-time relMSE")

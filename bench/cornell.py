@@ -84,6 +84,8 @@ def main() -> None:
     ap.add_argument("--ref-spp", type=int, default=1024)
     ap.add_argument("--variants", default="llvm_ad_rgb,scalar_rgb")
     ap.add_argument("--skip-build", action="store_true")
+    ap.add_argument("--sampler", choices=["independent", "sobol"],
+                    help="Candela's --sampler (default: the scene's, i.e. Candela's default)")
     a = ap.parse_args()
     variants = [v for v in a.variants.split(",") if v]
     if "llvm_ad_rgb" in variants and mitsuba_render.libllvm_path() is None:
@@ -102,7 +104,7 @@ def main() -> None:
         print(f"[cornell] run {rep + 1}/{a.repeats}: candela", flush=True)
         runs["candela"].append(candela.render(
             CANDELA, SCENE_TOML, out, spp=a.spp, max_depth=a.max_depth, threads=a.threads,
-            res=res, seed=rep, cwd=REPO).__dict__ | {"out": out})
+            res=res, seed=rep, cwd=REPO, sampler=a.sampler).__dict__ | {"out": out})
         for v in variants:
             print(f"[cornell] run {rep + 1}/{a.repeats}: mitsuba {v}", flush=True)
             out = os.path.join(OUT, f"mitsuba_{v}_{rep}.exr")
@@ -131,6 +133,7 @@ def render_report(a, variants, runs, ref, ref_meta) -> str:
             "scalar_rgb": "Mitsuba 3 scalar_rgb"}
     t_candela = statistics.median(r["render_s"] for r in runs["candela"])
     rows, stat_rows, side_rows, first_images = [], [], [], {}
+    equal_error = {}  # key -> (time used, relMSE)
     for key in ["candela"] + variants:
         rs = runs[key]
         if key == "candela":
@@ -150,6 +153,9 @@ def render_report(a, variants, runs, ref, ref_meta) -> str:
         imgs = [images.load_exr(r["out"]) for r in rs]
         first_images[key] = imgs[0]
         t = statistics.median(times)
+        warm_t = t if key == "candela" else statistics.median(
+            (r["warm"][0]["wall_s"] if r["warm"] else r["renders"][0]["wall_s"]) for r in rs)
+        equal_error[key] = (warm_t, statistics.mean(images.relmse(x, ref) for x in imgs))
         cpu = statistics.median(cpus)
         cpu_candela = statistics.median(r["cpu_s"] for r in runs["candela"])
         rows.append([name[key], report.fmt(t), report.fmt(min(times)), warm,
@@ -170,6 +176,23 @@ def render_report(a, variants, runs, ref, ref_meta) -> str:
         z = images.mean_difference_z(first_images["candela"], first_images[v])
         cross.append([f"Candela − {name[v]}", report.fmt_rgb(z, 2),
                       "yes" if max(abs(z)) < images.Z_CRIT else "**NO**"])
+
+    # Time to equal error. The Mitsuba reference shares the Mitsuba renders' estimator, so
+    # it adds relMSE_M·r/(1 + r), r = spp/ref_spp, to every relMSE; that share is taken
+    # off. Each Mitsuba variant's time to Candela's error follows from its independent
+    # samples, whose relMSE falls exactly as 1/time in expectation: t·relMSE/relMSE_C.
+    r = a.spp / ref_meta["spp"]
+    mitsuba_relmse = [equal_error[v][1] for v in variants]
+    ref_noise = statistics.median(mitsuba_relmse) * r / (1 + r) if variants else 0.0
+    t_c, e_c = equal_error["candela"]
+    e_c_net = max(e_c - ref_noise, 1e-12)
+    ee_rows = []
+    for key in ["candela"] + variants:
+        t, e = equal_error[key]
+        e_net = max(e - ref_noise, 1e-12)
+        t_eq = t * e_net / e_c_net
+        ee_rows.append([name[key], report.fmt(t), f"{e:.5f}", f"{e_net:.5f}",
+                        report.fmt(t_eq), report.fmt(t_eq / t_c)])
 
     m = machine.describe(REPO)
     mi_run = runs[variants[0]][0] if variants else None
@@ -200,6 +223,18 @@ def render_report(a, variants, runs, ref, ref_meta) -> str:
         f"{a.spp}-spp image's, its seeds being independent of theirs). "
         "*load1*: 1-minute load average just before each run (2 cores: load ≫ 2 means "
         "the timing was disturbed).",
+        "",
+        "Time to equal error (Candela's relMSE at its spp):",
+        "",
+        report.table(["renderer", "time s", "relMSE", "relMSE − ref noise",
+                      "s to Candela's error", "÷ Candela's time"], ee_rows),
+        "",
+        f"*time s*: median render time (Mitsuba llvm_ad_rgb: the warm render, kernels "
+        f"compiled). *relMSE − ref noise*: minus {ref_noise:.2e}, the share of the "
+        f"{ref_meta['spp']}-spp Mitsuba reference's own noise (Mitsuba relMSE × r/(1 + r), "
+        f"r = {r:.3g}). *s to Candela's error* = time × net relMSE ÷ Candela's net relMSE: "
+        "exact in expectation for Mitsuba's independent samples (relMSE ∝ 1/time); "
+        "*÷ Candela's time* above 1 means Candela reaches that error sooner.",
         "",
         "Mean radiance (first run's image) and z of the mean pixel difference against the "
         f"reference, per channel (agree: all |z| < {images.Z_CRIT}, α = 0.001 two-sided):",

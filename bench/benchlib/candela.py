@@ -44,11 +44,14 @@ def parse_summary(stdout: str) -> Optional[re.Match]:
 
 
 def render(binary: str, scene: str, out: str, *, spp: int, max_depth: int, threads: int,
-           res: tuple, seed: Optional[int] = None, cwd: Optional[str] = None) -> CandelaRun:
+           res: tuple, seed: Optional[int] = None, cwd: Optional[str] = None,
+           sampler: Optional[str] = None) -> CandelaRun:
     cmd = [binary, "render", scene, "-o", out, "--spp", str(spp), "--max-depth",
            str(max_depth), "--threads", str(threads), "--res", f"{res[0]}x{res[1]}"]
     if seed is not None:
         cmd += ["--seed", str(seed)]
+    if sampler is not None:
+        cmd += ["--sampler", sampler]
     load_before = machine.loadavg()
     c0 = _children_cpu_s()
     t0 = time.perf_counter()

@@ -521,9 +521,11 @@ pub enum LightSamplerKind {
 #[serde(rename_all = "kebab-case")]
 pub enum SamplerKind {
     /// Independent uniform numbers (PCG32).
-    #[default]
     Independent,
-    /// Owen-scrambled Sobol' points, stratified within each pixel.
+    /// Owen-scrambled Sobol' points, stratified within each pixel; the default, since
+    /// `bench/sampler.sh` measured 1.7× lower relMSE at 64 spp on the Cornell box and the
+    /// depth-of-field scene for a few percent more time.
+    #[default]
     Sobol,
 }
 

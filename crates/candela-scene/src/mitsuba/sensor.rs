@@ -2,7 +2,7 @@
 //! render settings.
 
 use candela_core::desc::{
-    ApertureDesc, ApertureSizeDesc, CameraDesc, FocusDesc, LensDesc, PixelFilterDesc,
+    ApertureDesc, ApertureSizeDesc, CameraDesc, FocusDesc, LensDesc, PixelFilterDesc, SamplerKind,
 };
 use glam::{Mat4, Vec3};
 
@@ -208,11 +208,15 @@ fn film(ctx: &mut Ctx, node: &Node) -> Result<(), LoadError> {
 
 fn sampler(ctx: &mut Ctx, node: &Node) -> Result<(), LoadError> {
     match node.kind() {
-        "independent" => {}
-        "stratified" | "multijitter" | "orthogonal" | "ldsampler" => ctx.warn(
-            node,
-            "Candela samples independently; the image converges to the same result",
-        ),
+        "independent" => ctx.desc.render.sampler = SamplerKind::Independent,
+        "stratified" | "multijitter" | "orthogonal" | "ldsampler" => {
+            ctx.desc.render.sampler = SamplerKind::Sobol;
+            ctx.warn(
+                node,
+                "Candela uses its Sobol' sampler instead; the image converges to the same \
+                 result",
+            )
+        }
         _ => return ctx.unsupported(node, format!("<{}> is not supported", describe(node))),
     }
     if let Some(n) = node.integer("sample_count")? {
