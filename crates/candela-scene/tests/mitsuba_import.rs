@@ -6,7 +6,9 @@
 use std::path::Path;
 
 use candela_core::camera::Camera;
-use candela_core::desc::{BsdfDesc, GeometryDesc, LightKindDesc, SceneDesc, TextureDesc};
+use candela_core::desc::{
+    BsdfDesc, GeometryDesc, LightKindDesc, SamplerKind, SceneDesc, TextureDesc,
+};
 use candela_scene::{load_scene_with, LoadError, LoadOptions, LoadedScene};
 use glam::{Vec2, Vec3};
 
@@ -337,6 +339,35 @@ fn render_settings_follow_film_sampler_and_integrator() {
         (r.width, r.height, r.spp, r.seed, r.max_depth),
         (30, 20, 7, 9, 4)
     );
+    // Mitsuba's independent sampler stays independent; its low-discrepancy samplers become
+    // Candela's Sobol' sampler, with a warning; no sampler keeps Candela's default.
+    assert_eq!(r.sampler, SamplerKind::Independent);
+    let (_dir, loaded) = load_files(
+        &[(
+            "scene.xml",
+            &scene(
+                r#"<sensor type="perspective"><float name="fov" value="40"/>
+                     <sampler type="ldsampler"/></sensor>"#,
+            ),
+        )],
+        &[],
+        false,
+    );
+    let loaded = loaded.unwrap();
+    assert_eq!(loaded.desc.render.sampler, SamplerKind::Sobol);
+    assert!(
+        loaded
+            .warnings
+            .iter()
+            .any(|w| w.to_string().contains("Sobol")),
+        "{:?}",
+        loaded
+            .warnings
+            .iter()
+            .map(|w| w.to_string())
+            .collect::<Vec<_>>()
+    );
+    assert_eq!(load(&scene("")).render.sampler, SamplerKind::default());
     // Without an integrator, Mitsuba's default path tracer has unlimited depth.
     assert_eq!(load(&scene("")).render.max_depth, 1024);
     use candela_scene::mitsuba::candela_max_depth;
