@@ -18,11 +18,11 @@
 //!   that of the largest block, the rest adds well-spread points but no finer strata.
 //! - **Unbiasedness.** An Owen-scrambled point is uniform on the unit square, so every
 //!   sample is a uniform sample, as with the independent sampler.
-//! - **Padding.** Every request (dimension index) of every pixel gets independent hashes,
-//!   so two requests are never correlated with each other and pixels are independent of
-//!   one another, which the per-pixel statistics of the tests rely on. Only within one
-//!   2D request are the two coordinates jointly stratified (the pairs the integrator
-//!   takes together: pixel position, lens point, light point, BSDF direction).
+//! - **Padding.** Every request (dimension index) of every pixel gets its own hashes, so
+//!   two requests are uncorrelated (as far as the hash is random) and pixels are
+//!   independent of one another, which the per-pixel statistics of the tests rely on. Only
+//!   within one 2D request are the two coordinates jointly stratified (the pairs the
+//!   integrator takes together: pixel position, lens point, light point, BSDF direction).
 //!
 //! Why the shuffle keeps the nets: a nested scramble of the index (bit-reversed, so that
 //! each bit is flipped by a hash of the bits *above* it) maps every aligned block of 2ᵏ
