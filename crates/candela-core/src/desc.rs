@@ -523,8 +523,8 @@ pub enum SamplerKind {
     /// Independent uniform numbers (PCG32).
     Independent,
     /// Owen-scrambled Sobol' points, stratified within each pixel; the default, since
-    /// `bench/sampler.sh` measured 1.7× lower relMSE at 64 spp on the Cornell box and the
-    /// depth-of-field scene for a few percent more time.
+    /// `bench/sampler.sh` measured 1.56× lower relMSE at 64 spp on the 512² Cornell box
+    /// and 1.68× on the depth-of-field scene for 5–10 % more time (bench/RESULTS.md).
     #[default]
     Sobol,
 }
