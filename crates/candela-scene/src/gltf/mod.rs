@@ -37,9 +37,6 @@ pub const SUPPORTED_EXTENSIONS: &[&str] = &[
     "KHR_texture_transform",
 ];
 
-/// Deepest node hierarchy accepted (a guard against cycles, which the JSON can express).
-const MAX_DEPTH: usize = 256;
-
 /// What a glTF scene contributes: shapes placed in the world, their materials, lights,
 /// and the first camera if it has one.
 #[derive(Clone, Debug, Default)]
@@ -119,6 +116,30 @@ fn gltf_error(file: &str, e: gltf::Error) -> LoadError {
     }
 }
 
+/// Checks what `gltf-json` 1.4's validation indexes without a bounds check (it would
+/// panic on a POSITION accessor that does not exist).
+fn check_position_indices(file: &str, root: &gltf::json::Root) -> Result<(), LoadError> {
+    let positions = gltf::json::validation::Checked::Valid(gltf::Semantic::Positions);
+    for (m, mesh) in root.meshes.iter().enumerate() {
+        for (p, prim) in mesh.primitives.iter().enumerate() {
+            if let Some(a) = prim.attributes.get(&positions) {
+                if a.value() >= root.accessors.len() {
+                    return Err(LoadError::new(
+                        Span::new(file, 0, 0),
+                        format!(
+                            "meshes[{m}].primitives[{p}].attributes.POSITION: accessors[{}] \
+                             does not exist ({} accessors)",
+                            a.value(),
+                            root.accessors.len()
+                        ),
+                    ));
+                }
+            }
+        }
+    }
+    Ok(())
+}
+
 /// Parses a glTF or GLB file held in memory into the shapes, materials, lights and
 /// camera of one of its scenes (`options.scene`, else the default, else the first).
 /// External files resolve against `base`; `file` names the source in messages.
@@ -151,6 +172,7 @@ pub fn parse_gltf_scene(
             ));
         }
     }
+    check_position_indices(&name, document.as_json())?;
     // Validation resolves every index (out-of-range references are errors here).
     let document =
         gltf::Document::from_json(document.into_json()).map_err(|e| gltf_error(&name, e))?;
@@ -182,14 +204,16 @@ pub fn parse_gltf_scene(
     let mut out = GltfScene::default();
     let mut materials = material::Materials::default();
     let mut meshes = mesh::MeshCache::default();
-    let mut stack: Vec<(gltf::Node, Mat4, usize)> =
-        scene.nodes().map(|n| (n, Mat4::IDENTITY, 0)).collect();
+    let mut stack: Vec<(gltf::Node, Mat4)> = scene.nodes().map(|n| (n, Mat4::IDENTITY)).collect();
     stack.reverse();
-    while let Some((node, parent, depth)) = stack.pop() {
-        if depth > MAX_DEPTH {
+    // Nodes form disjoint trees (glTF 2.0 §3.5.3): meeting one twice means a cycle or a
+    // shared child, and either would never end or place things twice.
+    let mut visited = HashSet::new();
+    while let Some((node, parent)) = stack.pop() {
+        if !visited.insert(node.index()) {
             return Err(ctx.error(
                 &format!("nodes[{}]", node.index()),
-                format!("node hierarchy deeper than {MAX_DEPTH} (a cycle?)"),
+                "the node is reached twice: the hierarchy has a cycle or a shared child",
             ));
         }
         let world = parent * Mat4::from_cols_array_2d(&node.transform().matrix());
@@ -217,7 +241,7 @@ pub fn parse_gltf_scene(
         let mut children: Vec<_> = node.children().collect();
         children.reverse();
         for child in children {
-            stack.push((child, world, depth + 1));
+            stack.push((child, world));
         }
     }
     out.materials = materials.into_descs();
