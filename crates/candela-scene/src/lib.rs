@@ -40,6 +40,7 @@ pub mod obj;
 pub mod ply;
 mod toml_camera;
 mod toml_environment;
+mod toml_include;
 mod toml_light;
 mod toml_material;
 pub mod toml_scene;
@@ -161,11 +162,8 @@ pub fn load_scene_with(path: &Path, options: &LoadOptions) -> Result<LoadedScene
         "toml" => {
             let text = std::fs::read_to_string(path)
                 .map_err(|e| LoadError::new(file_span(), format!("cannot read scene file: {e}")))?;
-            let desc = parse_toml_scene(&text, path)?;
-            Ok(LoadedScene {
-                desc,
-                warnings: Vec::new(),
-            })
+            let (desc, warnings) = toml_scene::parse_toml_scene_with_warnings(&text, path)?;
+            Ok(LoadedScene { desc, warnings })
         }
         "xml" => mitsuba::load_mitsuba(path, options),
         "gltf" | "glb" => crate::gltf::load_gltf(path, options),
