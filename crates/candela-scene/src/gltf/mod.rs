@@ -23,6 +23,7 @@ use glam::Mat4;
 use crate::{LoadError, LoadOptions, LoadedScene};
 
 pub mod camera;
+mod image;
 pub mod light;
 pub mod material;
 pub mod mesh;
