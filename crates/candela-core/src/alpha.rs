@@ -114,6 +114,7 @@ mod tests {
         }
         let e = n as f64 / 10.0;
         let chi2: f64 = bins.iter().map(|&b| (b as f64 - e).powi(2) / e).sum();
+        eprintln!("hit_uniform: chi2 {chi2:.2} (9 dof), bins {bins:?}");
         assert!(chi2 < 27.9, "chi2 {chi2}, bins {bins:?}");
     }
 

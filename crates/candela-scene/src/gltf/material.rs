@@ -163,6 +163,11 @@ impl Materials {
         let normal = m.normal_texture();
         if let Some(n) = &normal {
             let scale = n.scale();
+            // The `gltf` crate reads KHR_texture_transform only on plain texture slots.
+            let transform = n
+                .extension_value("KHR_texture_transform")
+                .map(json_texture_transform);
+            let set = transform.and_then(|t| t.3).unwrap_or(n.tex_coord());
             let map = self.image_texture(
                 ctx,
                 &path,
@@ -170,9 +175,9 @@ impl Materials {
                 Use::Normal(scale.to_bits()),
                 Vec3::ONE,
                 None,
-                n.tex_coord(),
+                set,
                 tex_coord,
-                None,
+                transform.map(|(o, r, s, _)| (o, r, s)),
             )?;
             bsdf = BsdfDesc::NormalMap {
                 map,
@@ -335,6 +340,26 @@ impl Materials {
     }
 }
 
+/// KHR_texture_transform's offset, rotation, scale and texCoord from its JSON, with the
+/// extension's defaults.
+fn json_texture_transform(v: &gltf::json::Value) -> ([f32; 2], f32, [f32; 2], Option<u32>) {
+    let pair = |key: &str, default: [f32; 2]| {
+        v.get(key)
+            .and_then(|a| a.as_array())
+            .filter(|a| a.len() == 2)
+            .and_then(|a| Some([a[0].as_f64()? as f32, a[1].as_f64()? as f32]))
+            .unwrap_or(default)
+    };
+    let rotation = v.get("rotation").and_then(|r| r.as_f64()).unwrap_or(0.0) as f32;
+    let set = v.get("texCoord").and_then(|t| t.as_u64()).map(|t| t as u32);
+    (
+        pair("offset", [0.0; 2]),
+        rotation,
+        pair("scale", [1.0; 2]),
+        set,
+    )
+}
+
 /// The TEXCOORD set a texture slot reads (KHR_texture_transform may override it).
 fn tex_coord(info: &gltf::texture::Info) -> u32 {
     info.texture_transform()
@@ -387,5 +412,19 @@ mod tests {
             "{got}"
         );
         assert_eq!(uv_transform([0.0; 2], 0.0, [1.0; 2]), Affine2::IDENTITY);
+    }
+
+    #[test]
+    fn texture_transform_json_has_the_extension_defaults() {
+        let v = serde_json::json!({"offset": [0.5, 0.25], "texCoord": 1});
+        assert_eq!(
+            json_texture_transform(&v),
+            ([0.5, 0.25], 0.0, [1.0, 1.0], Some(1))
+        );
+        let v = serde_json::json!({"rotation": 0.5, "scale": [2, 3], "offset": "bad"});
+        assert_eq!(
+            json_texture_transform(&v),
+            ([0.0, 0.0], 0.5, [2.0, 3.0], None)
+        );
     }
 }
