@@ -28,7 +28,7 @@ enum Command {
     Render(render::RenderArgs),
     /// Print what a scene contains: shapes, triangles, lights, materials, camera, bounds.
     Info {
-        /// Scene file (.toml, or Mitsuba 3 .xml).
+        /// Scene file (.toml, Mitsuba 3 .xml, glTF .gltf or .glb).
         scene: PathBuf,
         #[command(flatten)]
         load: render::LoadArgs,

@@ -10,7 +10,8 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
 
 use candela_core::desc::{
-    ApertureSizeDesc, FocusDesc, LensDesc, LightSamplerKind, MisMode, SamplerKind, SceneDesc,
+    ApertureSizeDesc, EnvironmentDesc, EnvironmentMapDesc, FocusDesc, LensDesc, LightSamplerKind,
+    MisMode, SamplerKind, SceneDesc, Span,
 };
 use candela_core::integrator;
 use clap::Args;
@@ -29,6 +30,9 @@ pub struct LoadArgs {
     /// Warn about and skip what Candela does not support instead of failing.
     #[arg(long)]
     lenient: bool,
+    /// Which scene of a glTF file to load (default: its default scene, else the first).
+    #[arg(long = "scene", value_name = "N")]
+    gltf_scene: Option<usize>,
 }
 
 fn parse_define(s: &str) -> Result<(String, String), String> {
@@ -44,6 +48,7 @@ impl LoadArgs {
         let options = candela_scene::LoadOptions {
             defines: self.define.clone(),
             lenient: self.lenient,
+            scene: self.gltf_scene,
         };
         let loaded = candela_scene::load_scene_with(path, &options)?;
         for w in &loaded.warnings {
@@ -55,10 +60,17 @@ impl LoadArgs {
 
 #[derive(Args)]
 pub struct RenderArgs {
-    /// Scene file (.toml, or Mitsuba 3 .xml).
+    /// Scene file (.toml, Mitsuba 3 .xml, glTF 2.0 .gltf or .glb).
     scene: PathBuf,
     #[command(flatten)]
     load: LoadArgs,
+    /// Light the scene with this latitude-longitude environment map (.hdr, .exr, or an
+    /// sRGB image), replacing the scene's own environment.
+    #[arg(long)]
+    env: Option<PathBuf>,
+    /// Scales the environment's radiance (the scene's own, or --env's).
+    #[arg(long)]
+    env_strength: Option<f32>,
     /// Output image: .exr, .pfm (linear) or .png (sRGB).
     #[arg(short, long)]
     output: PathBuf,
@@ -170,6 +182,32 @@ impl RenderArgs {
     }
 }
 
+impl RenderArgs {
+    /// `--env` and `--env-strength`.
+    fn apply_environment(&self, desc: &mut SceneDesc) -> Result<(), UserError> {
+        if let Some(path) = &self.env {
+            let img = candela_scene::environment::load_linear_image(path)
+                .map_err(|e| UserError(format!("{}: {e}", path.display())))?;
+            desc.environment = Some(EnvironmentDesc {
+                map: EnvironmentMapDesc::Equirect(img),
+                span: Span::new(path.display().to_string(), 0, 0),
+                ..EnvironmentDesc::default()
+            });
+        }
+        if let Some(s) = self.env_strength {
+            match &mut desc.environment {
+                Some(env) => env.strength = s,
+                None => {
+                    return Err(UserError(
+                        "--env-strength needs an environment (the scene's or --env)".into(),
+                    ))
+                }
+            }
+        }
+        Ok(())
+    }
+}
+
 static CANCEL: AtomicBool = AtomicBool::new(false);
 
 fn install_interrupt_handler() {
@@ -187,6 +225,7 @@ pub fn run(args: RenderArgs) -> Result<ExitCode, UserError> {
     ImageFormat::from_path(&args.output)?;
     let mut desc = args.load.load(&args.scene)?;
     args.apply_overrides(&mut desc);
+    args.apply_environment(&mut desc)?;
     let scene = candela_core::build::build(&desc)?;
     let s = &scene.settings;
 

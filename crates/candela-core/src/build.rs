@@ -7,6 +7,7 @@ use std::fmt;
 
 use glam::{Mat3, Mat4, Vec2, Vec3};
 
+use crate::alpha::{AlphaMask, AlphaMode};
 use crate::bsdf::{
     Conductor, ConductorFresnel, Dielectric, Lobe, Plastic, ThinDielectric, TrowbridgeReitz,
 };
@@ -84,6 +85,7 @@ pub fn build(desc: &SceneDesc) -> Result<Scene, BuildError> {
     let camera = build_camera(desc)?;
 
     let mut materials = Vec::with_capacity(desc.materials.len());
+    let mut alphas = Vec::with_capacity(desc.materials.len());
     let mut material_ids: HashMap<&str, MaterialId> = HashMap::new();
     for m in &desc.materials {
         if material_ids
@@ -93,6 +95,7 @@ pub fn build(desc: &SceneDesc) -> Result<Scene, BuildError> {
             return err(&m.span, format!("material \"{}\" is defined twice", m.name));
         }
         materials.push(build_material(&m.bsdf, &m.span)?);
+        alphas.push(build_alpha(&m.bsdf, &m.span)?);
     }
 
     let mut meshes = Vec::new();
@@ -115,6 +118,15 @@ pub fn build(desc: &SceneDesc) -> Result<Scene, BuildError> {
         }
         let emission = shape.emission.filter(|le| *le != Vec3::ZERO);
         match &shape.geometry {
+            GeometryDesc::Sphere { .. } if alphas[material.0 as usize].is_some() => {
+                return err(
+                    &shape.span,
+                    format!(
+                        "material \"{}\" has alpha, which only meshes support",
+                        shape.material
+                    ),
+                );
+            }
             GeometryDesc::Sphere { center, radius } => {
                 let sphere = build_sphere(shape, *center, *radius, material)?;
                 let light = emission.map(|le| {
@@ -141,6 +153,7 @@ pub fn build(desc: &SceneDesc) -> Result<Scene, BuildError> {
                 };
                 let mut mesh = to_world(local, shape.transform, material);
                 mesh.flip_normals = shape.flip_normals;
+                mesh.alpha = alphas[material.0 as usize].clone();
                 if let Some(le) = emission {
                     lights::triangle_lights(desc, shape_index, &mut mesh, le, &mut lights);
                 }
@@ -524,7 +537,33 @@ fn build_material(bsdf: &BsdfDesc, span: &Span) -> Result<Material, BuildError> 
             inner: Box::new(build_material(inner, span)?),
         },
         BsdfDesc::OneSided(inner) => Material::OneSided(Box::new(build_material(inner, span)?)),
+        BsdfDesc::Alpha { inner, .. } => build_material(inner, span)?,
     })
+}
+
+/// The coverage a material asks for (an [`BsdfDesc::Alpha`] at any depth of wrappers).
+fn build_alpha(bsdf: &BsdfDesc, span: &Span) -> Result<Option<AlphaMask>, BuildError> {
+    match bsdf {
+        BsdfDesc::Alpha { alpha, .. } => {
+            check_finite(span, "alpha", &[alpha.factor])?;
+            if let AlphaMode::Mask { cutoff } = alpha.mode {
+                check_finite(span, "alpha cutoff", &[cutoff])?;
+            }
+            let texture = match &alpha.texture {
+                Some(t) => Some(build_texture(t, span, "alpha")?),
+                None => None,
+            };
+            Ok(Some(AlphaMask {
+                mode: alpha.mode,
+                factor: alpha.factor,
+                texture,
+            }))
+        }
+        BsdfDesc::TwoSided(inner)
+        | BsdfDesc::OneSided(inner)
+        | BsdfDesc::NormalMap { inner, .. } => build_alpha(inner, span),
+        _ => Ok(None),
+    }
 }
 
 fn build_sphere(
@@ -629,6 +668,7 @@ fn to_world(local: MeshDesc, m: Mat4, material: MaterialId) -> Mesh {
         material,
         lights: Vec::new(),
         flip_normals: false,
+        alpha: None,
     }
 }
 

@@ -197,6 +197,20 @@ pub enum BsdfDesc {
     /// The inner BSDF on the front (the side the shading normal points to) and black
     /// from the back, as Mitsuba's reflective BSDFs are unless wrapped in `twosided`.
     OneSided(Box<BsdfDesc>),
+    /// The inner BSDF on a surface that is cut out (`Mask`) or see-through (`Blend`) by
+    /// α, glTF's alpha modes. Meshes only; see [`crate::alpha`].
+    Alpha {
+        alpha: AlphaDesc,
+        inner: Box<BsdfDesc>,
+    },
+}
+
+/// A surface's coverage α = `factor` × the texture's first channel (1 without one).
+#[derive(Clone, Debug)]
+pub struct AlphaDesc {
+    pub mode: crate::alpha::AlphaMode,
+    pub factor: f32,
+    pub texture: Option<TextureDesc>,
 }
 
 /// A colour (or, read through one channel, a scalar) that may vary over a surface.

@@ -27,6 +27,8 @@ pub struct Mesh {
     pub lights: Vec<LightId>,
     /// Geometric normals point away from the winding's front side when set.
     pub flip_normals: bool,
+    /// Where the surface is cut out or see-through (glTF alpha modes); see [`crate::alpha`].
+    pub alpha: Option<crate::alpha::AlphaMask>,
 }
 
 impl Mesh {
@@ -146,7 +148,11 @@ impl Scene {
                     Prim::Triangle { mesh, tri } => {
                         let [p0, p1, p2] = self.meshes[mesh as usize].vertices(tri);
                         let hit = wray.intersect(p0, p1, p2, t_max)?;
-                        bary = Vec2::new(hit.b1, hit.b2);
+                        let b = Vec2::new(hit.b1, hit.b2);
+                        if self.alpha_rejects(mesh, tri, b, ray) {
+                            return None;
+                        }
+                        bary = b;
                         Some(hit.t)
                     }
                     Prim::Sphere(s) => {
@@ -165,7 +171,9 @@ impl Scene {
             .occluded(ray, t_max, |i, t_max| match self.prims[i as usize] {
                 Prim::Triangle { mesh, tri } => {
                     let [p0, p1, p2] = self.meshes[mesh as usize].vertices(tri);
-                    wray.intersect(p0, p1, p2, t_max).is_some()
+                    wray.intersect(p0, p1, p2, t_max).is_some_and(|hit| {
+                        !self.alpha_rejects(mesh, tri, Vec2::new(hit.b1, hit.b2), ray)
+                    })
                 }
                 Prim::Sphere(s) => {
                     let s = &self.spheres[s as usize];

@@ -3,7 +3,7 @@
 //!
 //! One module per format: [`toml_scene`] reads Candela's own scene format (see
 //! `docs/scene-format.md`), [`mitsuba`] a subset of Mitsuba 3's XML (see
-//! `docs/mitsuba.md`), [`obj`] and [`ply`] read triangle meshes. A new scene format
+//! `docs/mitsuba.md`), [`gltf`] glTF 2.0, [`obj`] and [`ply`] read triangle meshes. A new scene format
 //! plugs in as a module and one arm of the match in [`load_scene`].
 //!
 //! ```
@@ -34,11 +34,13 @@ use std::sync::Arc;
 use candela_core::desc::{MeshDesc, SceneDesc, Span};
 
 pub mod environment;
+pub mod gltf;
 pub mod image_texture;
 pub mod obj;
 pub mod ply;
 mod toml_camera;
 mod toml_environment;
+mod toml_include;
 mod toml_light;
 mod toml_material;
 pub mod toml_scene;
@@ -58,6 +60,8 @@ pub struct LoadOptions {
     pub defines: Vec<(String, String)>,
     /// Warn about and skip what Candela does not support, instead of failing.
     pub lenient: bool,
+    /// Which of a glTF file's scenes to load (default: its default scene, else the first).
+    pub scene: Option<usize>,
 }
 
 /// A loaded scene and the warnings met on the way (already `file:line:col: …`).
@@ -146,7 +150,8 @@ pub fn load_scene(path: &Path) -> Result<SceneDesc, LoadError> {
     load_scene_with(path, &LoadOptions::default()).map(|l| l.desc)
 }
 
-/// Loads a scene file (`.toml` or Mitsuba `.xml`), choosing the format by its extension.
+/// Loads a scene file (`.toml`, Mitsuba `.xml`, glTF `.gltf`/`.glb`), choosing the format
+/// by its extension.
 pub fn load_scene_with(path: &Path, options: &LoadOptions) -> Result<LoadedScene, LoadError> {
     let file_span = || Span::new(path.display().to_string(), 1, 1);
     let ext = path
@@ -157,20 +162,18 @@ pub fn load_scene_with(path: &Path, options: &LoadOptions) -> Result<LoadedScene
         "toml" => {
             let text = std::fs::read_to_string(path)
                 .map_err(|e| LoadError::new(file_span(), format!("cannot read scene file: {e}")))?;
-            let desc = parse_toml_scene(&text, path)?;
-            Ok(LoadedScene {
-                desc,
-                warnings: Vec::new(),
-            })
+            let (desc, warnings) = toml_scene::parse_toml_scene_with_warnings(&text, path)?;
+            Ok(LoadedScene { desc, warnings })
         }
         "xml" => mitsuba::load_mitsuba(path, options),
+        "gltf" | "glb" => crate::gltf::load_gltf(path, options),
         "" => Err(LoadError::new(
             file_span(),
-            "scene file has no extension; expected .toml or .xml",
+            "scene file has no extension; expected .toml, .xml, .gltf or .glb",
         )),
         other => Err(LoadError::new(
             file_span(),
-            format!("unsupported scene format \".{other}\"; supported: .toml, .xml"),
+            format!("unsupported scene format \".{other}\"; supported: .toml, .xml, .gltf, .glb"),
         )),
     }
 }
@@ -234,7 +237,7 @@ mod tests {
 
     #[test]
     fn other_extensions_are_named_in_the_error() {
-        for ext in ["gltf", "glb"] {
+        for ext in ["fbx", "usd"] {
             let name = format!("scene.{ext}");
             let e = load_scene(Path::new(&name)).unwrap_err();
             assert_eq!(e.span, Span::new(name.as_str(), 1, 1));

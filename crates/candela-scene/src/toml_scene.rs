@@ -1,5 +1,6 @@
 //! Candela's TOML scene format (documented in `docs/scene-format.md`): `[render]`,
-//! `[camera]`, `[materials.NAME]`, `[[shape]]`, `[[light]]` and `[environment]`.
+//! `[camera]`, `[materials.NAME]`, `[[shape]]`, `[[light]]`, `[environment]` and
+//! `[[include]]` (glTF files).
 //!
 //! The document is first parsed into `toml`'s span-keeping tree ([`DeTable`]); each section
 //! is then deserialized on its own with `deny_unknown_fields`, so every error (unknown
@@ -20,6 +21,7 @@ use toml::Spanned;
 
 use crate::toml_camera::parse_camera;
 use crate::toml_environment::parse_environment;
+use crate::toml_include::parse_include;
 use crate::toml_light::parse_light;
 use crate::toml_material::{parse_material, MATERIAL_TYPES};
 use crate::toml_shape::parse_shape;
@@ -31,10 +33,21 @@ pub(crate) type Item<'i> = Spanned<DeValue<'i>>;
 /// Parses a TOML scene. Relative paths inside (mesh files) resolve against `file`'s
 /// folder; `file` is also the name errors are reported under.
 pub fn parse_toml_scene(text: &str, file: &Path) -> Result<SceneDesc, LoadError> {
+    parse_toml_scene_with_warnings(text, file).map(|(desc, _)| desc)
+}
+
+/// [`parse_toml_scene`] with the warnings met on the way (from included glTF files).
+pub fn parse_toml_scene_with_warnings(
+    text: &str,
+    file: &Path,
+) -> Result<(SceneDesc, Vec<String>), LoadError> {
     let src = Source::new(file, text);
+    let mut warnings = Vec::new();
+    let mut includes = 0;
     let root = DeTable::parse(text).map_err(|e| src.toml_error(&e))?;
     let base = file.parent().unwrap_or(Path::new(""));
     let mut desc = SceneDesc::default();
+    let mut included_materials = Vec::new();
     for (key, value) in root.into_inner() {
         let key_at = key.span().start;
         match key.get_ref().as_ref() {
@@ -60,18 +73,30 @@ pub fn parse_toml_scene(text: &str, file: &Path) -> Result<SceneDesc, LoadError>
                     desc.lights.push(parse_light(&src, base, item)?);
                 }
             }
+            "include" => {
+                for item in array_of_tables(&src, "include", value)? {
+                    let inc = parse_include(&src, base, item, includes)?;
+                    includes += 1;
+                    desc.shapes.extend(inc.shapes);
+                    included_materials.extend(inc.materials);
+                    desc.lights.extend(inc.lights);
+                    warnings.extend(inc.warnings);
+                }
+            }
             other => {
                 return Err(src.error(
                     key_at,
                     format!(
                         "unknown key `{other}`, expected one of `render`, `camera`, \
-                         `materials`, `shape`, `light`, `environment`"
+                         `materials`, `shape`, `light`, `environment`, `include`"
                     ),
                 ))
             }
         }
     }
-    Ok(desc)
+    // After the loop: `[materials]` may come after an `[[include]]` and replaces the list.
+    desc.materials.extend(included_materials);
+    Ok((desc, warnings))
 }
 
 /// Deserializes one item, keeping `toml`'s error location.

@@ -252,7 +252,7 @@ pub(crate) fn parse_shape(
 }
 
 /// Gives a step with several keys a clearer error than serde's enum message.
-fn check_transform_steps(src: &Source, item: &Item) -> Result<(), LoadError> {
+pub(crate) fn check_transform_steps(src: &Source, item: &Item) -> Result<(), LoadError> {
     let steps = item.get_ref().as_table().and_then(|t| t.get("transform"));
     let Some(steps) = steps.and_then(|s| s.get_ref().as_array()) else {
         return Ok(()); // absent, or a wrong type that serde reports

@@ -78,6 +78,7 @@ fn render_ranges(scene_file: &Path, defines: &[(&str, &str)]) -> Vec<Vec<Vec3>> 
             .map(|(k, v)| (k.to_string(), v.to_string()))
             .collect(),
         lenient: false,
+        ..LoadOptions::default()
     };
     let mut desc = load_scene_with(scene_file, &options).unwrap().desc;
     desc.render.width = RES as u32;
@@ -185,6 +186,7 @@ fn render_at_depth(m: &str, spp: u32) -> Option<Vec<Vec3>> {
         .map(|(k, v)| (k.to_string(), v.to_string()))
         .collect(),
         lenient: false,
+        ..LoadOptions::default()
     };
     let mut desc = load_scene_with(&data.join("mitsuba/cornell-box/scene.xml"), &options)
         .unwrap()

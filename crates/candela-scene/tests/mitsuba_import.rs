@@ -28,6 +28,7 @@ fn load_files(
             .map(|(k, v)| (k.to_string(), v.to_string()))
             .collect(),
         lenient,
+        ..LoadOptions::default()
     };
     let r = load_scene_with(&dir.path().join(files[0].0), &options);
     (dir, r)

@@ -125,7 +125,7 @@ fn reads_uv(ctx: &Ctx, material: &str) -> bool {
                 metallic,
                 roughness,
             } => texture(base_color) || texture(metallic) || texture(roughness),
-            BsdfDesc::NormalMap { .. } => true,
+            BsdfDesc::NormalMap { .. } | BsdfDesc::Alpha { .. } => true,
             BsdfDesc::TwoSided(inner) | BsdfDesc::OneSided(inner) => bsdf(inner),
             BsdfDesc::Conductor { .. } | BsdfDesc::Dielectric { .. } => false,
         }

@@ -1,0 +1,209 @@
+//! glTF meshes: each primitive becomes one shared [`MeshDesc`] (one `Arc` per primitive,
+//! whichever nodes place it) and one [`ShapeDesc`] per placement.
+//!
+//! - Topology: triangles, triangle strips (triangle i is (i, i+1, i+2) with the first two
+//!   swapped on odd i, glTF 2.0 §3.7.2.1) and fans ((i+1, i+2, 0)); points and lines are
+//!   skipped with a warning. Without indices the vertices are taken in order.
+//! - Normals: read where given; where missing they are left out, and the renderer shades
+//!   with the triangle's geometric normal — the flat normals glTF prescribes.
+//! - Texture coordinates: the set (TEXCOORD_0 or _1) that the material's textures name,
+//!   with v flipped (glTF's v runs down the image, Candela's up).
+//! - Tangents: the renderer derives the normal-map frame from ∂p/∂u of the uvs; TANGENT
+//!   is not read (a warning says so where a normal map meets one).
+
+use std::collections::HashMap;
+use std::sync::Arc;
+
+use candela_core::desc::{GeometryDesc, MeshDesc, ShapeDesc};
+use glam::{Mat4, Vec2, Vec3};
+use gltf::mesh::Mode;
+
+use super::material::Materials;
+use super::{Ctx, GltfScene};
+use crate::LoadError;
+
+/// Primitives already converted, by (mesh, primitive) index.
+#[derive(Default)]
+pub(crate) struct MeshCache {
+    prims: HashMap<(usize, usize), Option<Arc<MeshDesc>>>,
+}
+
+/// Places every primitive of `mesh` with the node's world transform.
+pub(crate) fn place_mesh(
+    ctx: &mut Ctx,
+    cache: &mut MeshCache,
+    materials: &mut Materials,
+    out: &mut GltfScene,
+    mesh: &gltf::Mesh,
+    world: Mat4,
+) -> Result<(), LoadError> {
+    for prim in mesh.primitives() {
+        let mat = materials.get(ctx, &prim.material())?;
+        let key = (mesh.index(), prim.index());
+        let desc = match cache.prims.get(&key) {
+            Some(d) => d.clone(),
+            None => {
+                let path = format!("meshes[{}].primitives[{}]", mesh.index(), prim.index());
+                let d = read_primitive(ctx, &prim, mat.tex_coord, &path)?.map(Arc::new);
+                if d.is_some()
+                    && mat.has_normal_map
+                    && prim.get(&gltf::Semantic::Tangents).is_some()
+                {
+                    ctx.warn(format!(
+                        "{path}: TANGENT is not read; normal maps use the tangent ∂p/∂u \
+                         of the texture coordinates"
+                    ));
+                }
+                if prim.get(&gltf::Semantic::Colors(0)).is_some() {
+                    ctx.warn(format!("{path}: vertex colors (COLOR_0) are ignored"));
+                }
+                if prim.morph_targets().next().is_some() {
+                    ctx.warn(format!("{path}: morph targets are ignored"));
+                }
+                cache.prims.insert(key, d.clone());
+                d
+            }
+        };
+        if let Some(desc) = desc {
+            out.shapes.push(ShapeDesc {
+                geometry: GeometryDesc::Mesh(desc),
+                material: mat.name.clone(),
+                emission: mat.emission,
+                transform: world,
+                flip_normals: false,
+                span: ctx.span(),
+            });
+        }
+    }
+    Ok(())
+}
+
+/// Why an accessor could not be read.
+fn unreadable(ctx: &Ctx, path: &str, what: &str, accessor: &gltf::Accessor) -> LoadError {
+    let detail = match accessor.view() {
+        None if accessor.sparse().is_none() => "has no buffer view".to_string(),
+        None => "is sparse without a base view, which Candela does not read".to_string(),
+        Some(v) => format!(
+            "accessor {} reads past the end of buffer view {} or buffer {}",
+            accessor.index(),
+            v.index(),
+            v.buffer().index()
+        ),
+    };
+    ctx.error(path, format!("{what}: {detail}"))
+}
+
+/// The primitive as a mesh in object space, or `None` where it has no triangles.
+fn read_primitive(
+    ctx: &mut Ctx,
+    prim: &gltf::Primitive,
+    tex_coord: u32,
+    path: &str,
+) -> Result<Option<MeshDesc>, LoadError> {
+    let mode = prim.mode();
+    if !matches!(
+        mode,
+        Mode::Triangles | Mode::TriangleStrip | Mode::TriangleFan
+    ) {
+        ctx.warn(format!("{path}: {mode:?} primitives are skipped"));
+        return Ok(None);
+    }
+    let buffers = &ctx.buffers;
+    let reader = prim.reader(|b| buffers.get(b.index()).map(|d| d.0.as_slice()));
+    let Some(pos_accessor) = prim.get(&gltf::Semantic::Positions) else {
+        return Err(ctx.error(path, "has no POSITION attribute"));
+    };
+    let positions: Vec<Vec3> = match reader.read_positions() {
+        Some(it) => it.map(Vec3::from).collect(),
+        None => return Err(unreadable(ctx, path, "POSITION", &pos_accessor)),
+    };
+    let n = positions.len();
+    let normals: Vec<Vec3> = match prim.get(&gltf::Semantic::Normals) {
+        None => Vec::new(),
+        Some(a) => match reader.read_normals() {
+            Some(it) => it.map(Vec3::from).collect(),
+            None => return Err(unreadable(ctx, path, "NORMAL", &a)),
+        },
+    };
+    let uvs: Vec<Vec2> = match prim.get(&gltf::Semantic::TexCoords(tex_coord)) {
+        None => Vec::new(),
+        Some(a) => match reader.read_tex_coords(tex_coord) {
+            Some(it) => it.into_f32().map(|[u, v]| Vec2::new(u, 1.0 - v)).collect(),
+            None => return Err(unreadable(ctx, path, &format!("TEXCOORD_{tex_coord}"), &a)),
+        },
+    };
+    for (what, len) in [("NORMAL", normals.len()), ("TEXCOORD", uvs.len())] {
+        if len != 0 && len != n {
+            return Err(ctx.error(path, format!("{what} has {len} elements for {n} positions")));
+        }
+    }
+    let order: Vec<u32> = match prim.indices() {
+        None => (0..n as u32).collect(),
+        Some(a) => match reader.read_indices() {
+            Some(it) => it.into_u32().collect(),
+            None => return Err(unreadable(ctx, path, "indices", &a)),
+        },
+    };
+    if let Some(&i) = order.iter().find(|&&i| i as usize >= n) {
+        return Err(ctx.error(path, format!("index {i} is out of range ({n} vertices)")));
+    }
+    let indices = triangulate(mode, &order);
+    if indices.is_empty() {
+        ctx.warn(format!("{path}: has no triangles and is skipped"));
+        return Ok(None);
+    }
+    if positions.iter().chain(&normals).any(|p| !p.is_finite())
+        || uvs.iter().any(|uv| !uv.is_finite())
+    {
+        return Err(ctx.error(path, "has a non-finite vertex attribute"));
+    }
+    Ok(Some(MeshDesc {
+        positions,
+        normals,
+        uvs,
+        indices,
+    }))
+}
+
+/// Triangles of a primitive from its vertex order (glTF 2.0 §3.7.2.1).
+pub fn triangulate(mode: Mode, order: &[u32]) -> Vec<[u32; 3]> {
+    match mode {
+        Mode::Triangles => order.chunks_exact(3).map(|t| [t[0], t[1], t[2]]).collect(),
+        Mode::TriangleStrip => (0..order.len().saturating_sub(2))
+            .map(|i| {
+                let (a, b) = (order[i], order[i + 1]);
+                let c = order[i + 2];
+                if i % 2 == 0 {
+                    [a, b, c]
+                } else {
+                    [b, a, c]
+                }
+            })
+            .collect(),
+        Mode::TriangleFan => (1..order.len().saturating_sub(1))
+            .map(|i| [order[i], order[i + 1], order[0]])
+            .collect(),
+        _ => Vec::new(),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn strips_and_fans_keep_the_winding() {
+        let order = [0, 1, 2, 3, 4];
+        assert_eq!(
+            triangulate(Mode::TriangleStrip, &order),
+            vec![[0, 1, 2], [2, 1, 3], [2, 3, 4]]
+        );
+        assert_eq!(
+            triangulate(Mode::TriangleFan, &order),
+            vec![[1, 2, 0], [2, 3, 0], [3, 4, 0]]
+        );
+        assert_eq!(triangulate(Mode::Triangles, &order), vec![[0, 1, 2]]);
+        assert!(triangulate(Mode::TriangleStrip, &[0, 1]).is_empty());
+        assert!(triangulate(Mode::TriangleFan, &[]).is_empty());
+    }
+}
