@@ -1,11 +1,11 @@
-//! A bounding volume hierarchy over primitive boxes, built with the binned surface area
-//! heuristic (Wald 2007, "On fast Construction of SAH-based Bounding Volume Hierarchies").
-//!
-//! The BVH knows nothing of triangles or spheres: traversal calls a closure with the index
-//! of each primitive whose box the ray enters, so any primitive type can sit in it.
+//! The binary BVH, built with the binned surface area heuristic (Wald 2007, "On fast
+//! Construction of SAH-based Bounding Volume Hierarchies"). Rendering traces the
+//! [`super::WideBvh`] collapsed from it; its own traversal, one box at a time, is the
+//! reference the tests compare against.
 
 use glam::Vec3;
 
+use super::box4::T_MAX_SCALE;
 use crate::geometry::{Aabb, Ray};
 
 const BINS: usize = 16;
@@ -14,6 +14,9 @@ const MAX_LEAF: usize = 4;
 const TRAVERSAL_COST: f32 = 1.0;
 /// Subtrees larger than this are built in parallel.
 const PARALLEL_THRESHOLD: usize = 4096;
+/// From this depth on, splits fall back to the median, so that no tree is deeper than
+/// about `MAX_SAH_DEPTH + log2(n)` and the traversal stacks cannot overflow.
+const MAX_SAH_DEPTH: usize = 48;
 
 /// A node of the flattened tree. An interior node's first child follows it directly and
 /// `offset` is its second child; a leaf holds `count` primitives from `offset` on.
@@ -85,7 +88,7 @@ impl Bvh {
         if infos.is_empty() {
             return Bvh::default();
         }
-        let root = build_recursive(&mut infos, 0);
+        let root = build_recursive(&mut infos, 0, 0);
         let mut bvh = Bvh {
             nodes: Vec::with_capacity(root.node_count()),
             prims: infos.iter().map(|p| p.index).collect(),
@@ -184,12 +187,13 @@ impl Bvh {
         }
         let inv_d = ray.d.recip();
         let neg = [inv_d.x < 0.0, inv_d.y < 0.0, inv_d.z < 0.0];
-        let mut stack = [0u32; 64];
+        let mut stack = [0u32; 128];
         let mut sp = 0usize;
         let mut current = 0usize;
         loop {
             let node = &self.nodes[current];
-            if node.bounds.hit(ray.o, inv_d, t_max).is_some() {
+            // Widened like the wide BVH's (see `T_MAX_SCALE`) so that both find the same hits.
+            if node.bounds.hit(ray.o, inv_d, t_max * T_MAX_SCALE).is_some() {
                 if node.is_leaf() {
                     let first = node.offset as usize;
                     for &prim in &self.prims[first..first + node.count as usize] {
@@ -221,7 +225,7 @@ impl Bvh {
     }
 }
 
-fn build_recursive(prims: &mut [PrimInfo], first: usize) -> BuildNode {
+fn build_recursive(prims: &mut [PrimInfo], first: usize, depth: usize) -> BuildNode {
     let bounds = prims.iter().fold(Aabb::EMPTY, |b, p| b.union(p.bounds));
     let n = prims.len();
     let leaf = BuildNode::Leaf {
@@ -235,12 +239,12 @@ fn build_recursive(prims: &mut [PrimInfo], first: usize) -> BuildNode {
     let centroids = prims.iter().fold(Aabb::EMPTY, |b, p| b.grow(p.centroid));
     let extent = centroids.extent();
     let axis = extent.max_position();
-    if extent[axis] <= 0.0 {
-        // All centroids coincide: no split separates them.
+    if extent[axis] <= 0.0 || depth >= MAX_SAH_DEPTH {
+        // All centroids coincide (no split separates them), or the tree is deep enough.
         return if n <= MAX_LEAF {
             leaf
         } else {
-            split_middle(prims, first, bounds, axis)
+            split_middle(prims, first, bounds, axis, depth)
         };
     }
 
@@ -285,16 +289,22 @@ fn build_recursive(prims: &mut [PrimInfo], first: usize) -> BuildNode {
         return leaf;
     }
     if !best_cost.is_finite() {
-        return split_middle(prims, first, bounds, axis);
+        return split_middle(prims, first, bounds, axis, depth);
     }
     let mid = partition(prims, |p| bin_of(p) <= best_split);
-    make_interior(prims, first, bounds, axis, mid)
+    make_interior(prims, first, bounds, axis, mid, depth)
 }
 
-fn split_middle(prims: &mut [PrimInfo], first: usize, bounds: Aabb, axis: usize) -> BuildNode {
+fn split_middle(
+    prims: &mut [PrimInfo],
+    first: usize,
+    bounds: Aabb,
+    axis: usize,
+    depth: usize,
+) -> BuildNode {
     let mid = prims.len() / 2;
     prims.select_nth_unstable_by(mid, |a, b| a.centroid[axis].total_cmp(&b.centroid[axis]));
-    make_interior(prims, first, bounds, axis, mid)
+    make_interior(prims, first, bounds, axis, mid, depth)
 }
 
 fn make_interior(
@@ -303,18 +313,19 @@ fn make_interior(
     bounds: Aabb,
     axis: usize,
     mid: usize,
+    depth: usize,
 ) -> BuildNode {
     let n = prims.len();
     let (left, right) = prims.split_at_mut(mid);
     let (a, b) = if n > PARALLEL_THRESHOLD {
         rayon::join(
-            || build_recursive(left, first),
-            || build_recursive(right, first + mid),
+            || build_recursive(left, first, depth + 1),
+            || build_recursive(right, first + mid, depth + 1),
         )
     } else {
         (
-            build_recursive(left, first),
-            build_recursive(right, first + mid),
+            build_recursive(left, first, depth + 1),
+            build_recursive(right, first + mid, depth + 1),
         )
     };
     let size = 1 + a.node_count() + b.node_count();

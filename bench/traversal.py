@@ -1,0 +1,78 @@
+"""Traces the rays Candela's `traversal` example wrote with Embree 4 (via embreex), and
+compares: rays per second per core for closest hit and any hit, and whether both found
+the same triangle at the same distance. Run by bench/traversal.sh.
+
+Usage: traversal.py DIR [DIR ...] (each written by `traversal rays SCENE DIR`); the
+Candela figures are read from DIR/candela.json."""
+import json
+import sys
+import time
+
+import numpy as np
+from embreex import rtcore_scene
+from embreex.mesh_construction import TriangleMesh
+
+
+def best_of(runs, f):
+    """The fastest of `runs` timings of f() and its last result."""
+    best, out = float("inf"), None
+    for _ in range(runs):
+        t = time.perf_counter()
+        out = f()
+        best = min(best, time.perf_counter() - t)
+    return best, out
+
+
+def bench(folder):
+    tris = np.fromfile(f"{folder}/tris.f32", dtype=np.float32).reshape(-1, 3, 3)
+    rays = np.fromfile(f"{folder}/rays.f32", dtype=np.float32).reshape(-1, 6)
+    o, d = np.ascontiguousarray(rays[:, :3]), np.ascontiguousarray(rays[:, 3:])
+    candela = json.load(open(f"{folder}/candela.json"))
+    hits = np.fromfile(f"{folder}/candela_hits.bin", dtype=np.dtype([("prim", "<u4"), ("t", "<f4")]))
+    t = time.perf_counter()
+    scene = rtcore_scene.EmbreeScene()
+    TriangleMesh(scene, tris)
+    scene.run(o[:1], d[:1])  # Embree builds its BVH on the first query.
+    build_s = time.perf_counter() - t
+    closest_s, res = best_of(3, lambda: scene.run(o, d, output=1))
+    any_s, occ = best_of(3, lambda: scene.run(o, d, query="OCCLUDED"))
+    n = len(o)
+    prim = res["primID"].astype(np.int64)
+    c_prim = np.where(hits["prim"] == 0xFFFFFFFF, -1, hits["prim"].astype(np.int64))
+    both = (prim >= 0) & (c_prim >= 0)
+    rel = np.abs(res["tfar"][both] - hits["t"][both]) / np.maximum(hits["t"][both], 1e-30)
+    return {
+        "scene": candela["scene"],
+        "triangles": len(tris),
+        "rays": n,
+        "candela_build_s": candela["build_s"],
+        "embree_build_s": build_s,
+        "candela_closest": candela["closest_mrays_s"],
+        "embree_closest": n / closest_s / 1e6,
+        "candela_any": candela["any_mrays_s"],
+        "embree_any": n / any_s / 1e6,
+        "same_hit_or_miss": float(np.mean((prim >= 0) == (c_prim >= 0))),
+        "same_triangle": float(np.mean(prim[both] == c_prim[both])) if both.any() else 1.0,
+        "t_rel_err_p99": float(np.quantile(rel, 0.99)) if both.any() else 0.0,
+        "embree_occluded_agree": float(np.mean((np.asarray(occ) != -1) == (c_prim >= 0))),
+    }
+
+
+def main():
+    rows = [bench(f) for f in sys.argv[1:]]
+    print()
+    print("| scene | triangles | rays | Candela closest (M rays/s) | Embree closest | ratio "
+          "| Candela any-hit | Embree any-hit | ratio | same hit/miss | same triangle | build Candela / Embree (s) |")
+    print("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|")
+    for r in rows:
+        print(f"| {r['scene']} | {r['triangles']} | {r['rays']} | {r['candela_closest']:.2f} | "
+              f"{r['embree_closest']:.2f} | {r['candela_closest'] / r['embree_closest']:.2f} | "
+              f"{r['candela_any']:.2f} | {r['embree_any']:.2f} | {r['candela_any'] / r['embree_any']:.2f} | "
+              f"{r['same_hit_or_miss']:.5f} | {r['same_triangle']:.5f} | "
+              f"{r['candela_build_s']:.3f} / {r['embree_build_s']:.3f} |")
+    print()
+    print(json.dumps(rows, indent=1))
+
+
+if __name__ == "__main__":
+    main()
