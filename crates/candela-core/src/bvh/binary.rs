@@ -3,7 +3,7 @@
 //! [`super::WideBvh`] collapsed from it; its own traversal, one box at a time, is the
 //! reference the tests compare against.
 
-use glam::Vec3;
+use glam::Vec3A;
 
 use super::box4::T_MAX_SCALE;
 use crate::geometry::{Aabb, Ray};
@@ -64,11 +64,85 @@ impl BuildNode {
     }
 }
 
+/// A primitive's box during the build, in SIMD vectors. Centroids are kept doubled
+/// (`min + max`), which bins exactly as the centroid does and saves a multiply.
 #[derive(Clone, Copy)]
 struct PrimInfo {
-    bounds: Aabb,
-    centroid: Vec3,
+    min: Vec3A,
+    max: Vec3A,
     index: u32,
+}
+
+impl PrimInfo {
+    #[inline(always)]
+    fn centroid2(&self) -> Vec3A {
+        self.min + self.max
+    }
+}
+
+/// A box in SIMD vectors, for the build's many unions.
+#[derive(Clone, Copy)]
+struct Box3A {
+    min: Vec3A,
+    max: Vec3A,
+}
+
+impl Box3A {
+    const EMPTY: Box3A = Box3A {
+        min: Vec3A::INFINITY,
+        max: Vec3A::NEG_INFINITY,
+    };
+
+    #[inline(always)]
+    fn grow(&mut self, p: Vec3A) {
+        self.min = self.min.min(p);
+        self.max = self.max.max(p);
+    }
+
+    #[inline(always)]
+    fn union(&mut self, min: Vec3A, max: Vec3A) {
+        self.min = self.min.min(min);
+        self.max = self.max.max(max);
+    }
+
+    fn aabb(&self) -> Aabb {
+        Aabb {
+            min: self.min.into(),
+            max: self.max.into(),
+        }
+    }
+}
+
+/// What every node of the build knows of its primitives: their boxes' bounds and the
+/// bounds of their (doubled) centroids, both gathered by the parent's binning pass.
+#[derive(Clone, Copy)]
+struct Extents {
+    bounds: Box3A,
+    centroids: Box3A,
+}
+
+impl Extents {
+    fn of(prims: &[PrimInfo]) -> Extents {
+        let mut e = Extents {
+            bounds: Box3A::EMPTY,
+            centroids: Box3A::EMPTY,
+        };
+        for p in prims {
+            e.add(p);
+        }
+        e
+    }
+
+    #[inline(always)]
+    fn add(&mut self, p: &PrimInfo) {
+        self.bounds.union(p.min, p.max);
+        self.centroids.grow(p.centroid2());
+    }
+
+    fn merge(&mut self, o: &Extents) {
+        self.bounds.union(o.bounds.min, o.bounds.max);
+        self.centroids.union(o.centroids.min, o.centroids.max);
+    }
 }
 
 impl Bvh {
@@ -80,15 +154,16 @@ impl Bvh {
             .enumerate()
             .filter(|(_, b)| !b.is_empty() && b.min.is_finite() && b.max.is_finite())
             .map(|(i, b)| PrimInfo {
-                bounds: *b,
-                centroid: b.center(),
+                min: b.min.into(),
+                max: b.max.into(),
                 index: i as u32,
             })
             .collect();
         if infos.is_empty() {
             return Bvh::default();
         }
-        let root = build_recursive(&mut infos, 0, 0);
+        let extents = Extents::of(&infos);
+        let root = build_recursive(&mut infos, 0, 0, extents);
         let mut bvh = Bvh {
             nodes: Vec::with_capacity(root.node_count()),
             prims: infos.iter().map(|p| p.index).collect(),
@@ -225,8 +300,8 @@ impl Bvh {
     }
 }
 
-fn build_recursive(prims: &mut [PrimInfo], first: usize, depth: usize) -> BuildNode {
-    let bounds = prims.iter().fold(Aabb::EMPTY, |b, p| b.union(p.bounds));
+fn build_recursive(prims: &mut [PrimInfo], first: usize, depth: usize, ext: Extents) -> BuildNode {
+    let bounds = ext.bounds.aabb();
     let n = prims.len();
     let leaf = BuildNode::Leaf {
         bounds,
@@ -236,8 +311,8 @@ fn build_recursive(prims: &mut [PrimInfo], first: usize, depth: usize) -> BuildN
     if n <= 1 {
         return leaf;
     }
-    let centroids = prims.iter().fold(Aabb::EMPTY, |b, p| b.grow(p.centroid));
-    let extent = centroids.extent();
+    let cmin = ext.centroids.min;
+    let extent = (ext.centroids.max - cmin).max(Vec3A::ZERO);
     let axis = extent.max_position();
     if extent[axis] <= 0.0 || depth >= MAX_SAH_DEPTH {
         // All centroids coincide (no split separates them), or the tree is deep enough.
@@ -249,35 +324,45 @@ fn build_recursive(prims: &mut [PrimInfo], first: usize, depth: usize) -> BuildN
     }
 
     // Bin centroids along the widest axis and sweep for the cheapest SAH split.
-    let scale = BINS as f32 / extent[axis];
-    let bin_of =
-        |p: &PrimInfo| (((p.centroid[axis] - centroids.min[axis]) * scale) as usize).min(BINS - 1);
-    let mut bin_bounds = [Aabb::EMPTY; BINS];
+    // Small nodes get fewer bins: for a handful of primitives, sixteen bins cost more
+    // to clear and sweep than they gain, and there are half a million such nodes per
+    // million triangles.
+    let nb = n.clamp(2, BINS);
+    let scale = nb as f32 / extent[axis];
+    let (c0, cmin_axis, last) = (axis, cmin[axis], nb as i32 - 1);
+    let bin_of = move |p: &PrimInfo| {
+        // Through i32: a plain truncating conversion (`as usize` checks for NaN).
+        (((p.centroid2()[c0] - cmin_axis) * scale) as i32).clamp(0, last) as usize
+    };
+    let mut bins = [Extents {
+        bounds: Box3A::EMPTY,
+        centroids: Box3A::EMPTY,
+    }; BINS];
     let mut bin_counts = [0usize; BINS];
     for p in prims.iter() {
         let b = bin_of(p);
         bin_counts[b] += 1;
-        bin_bounds[b] = bin_bounds[b].union(p.bounds);
+        bins[b].add(p);
     }
+    let area = |b: &Box3A| b.aabb().surface_area();
     let mut right_area = [0.0f32; BINS];
     let mut right_count = [0usize; BINS];
-    let (mut acc, mut count) = (Aabb::EMPTY, 0);
-    for i in (1..BINS).rev() {
-        acc = acc.union(bin_bounds[i]);
+    let (mut acc, mut count) = (Box3A::EMPTY, 0);
+    for i in (1..nb).rev() {
+        acc.union(bins[i].bounds.min, bins[i].bounds.max);
         count += bin_counts[i];
-        right_area[i] = acc.surface_area();
+        right_area[i] = area(&acc);
         right_count[i] = count;
     }
     let (mut best_cost, mut best_split) = (f32::INFINITY, 0);
-    let (mut acc, mut count) = (Aabb::EMPTY, 0);
-    for i in 0..BINS - 1 {
-        acc = acc.union(bin_bounds[i]);
+    let (mut acc, mut count) = (Box3A::EMPTY, 0);
+    for i in 0..nb - 1 {
+        acc.union(bins[i].bounds.min, bins[i].bounds.max);
         count += bin_counts[i];
         if count == 0 || right_count[i + 1] == 0 {
             continue;
         }
-        let cost =
-            count as f32 * acc.surface_area() + right_count[i + 1] as f32 * right_area[i + 1];
+        let cost = count as f32 * area(&acc) + right_count[i + 1] as f32 * right_area[i + 1];
         if cost < best_cost {
             best_cost = cost;
             best_split = i;
@@ -292,7 +377,14 @@ fn build_recursive(prims: &mut [PrimInfo], first: usize, depth: usize) -> BuildN
         return split_middle(prims, first, bounds, axis, depth);
     }
     let mid = partition(prims, |p| bin_of(p) <= best_split);
-    make_interior(prims, first, bounds, axis, mid, depth)
+    let (mut left, mut right) = (bins[0], bins[best_split + 1]);
+    for b in &bins[1..=best_split] {
+        left.merge(b);
+    }
+    for b in &bins[best_split + 2..nb] {
+        right.merge(b);
+    }
+    make_interior(prims, first, bounds, axis, mid, depth, Some((left, right)))
 }
 
 fn split_middle(
@@ -303,10 +395,15 @@ fn split_middle(
     depth: usize,
 ) -> BuildNode {
     let mid = prims.len() / 2;
-    prims.select_nth_unstable_by(mid, |a, b| a.centroid[axis].total_cmp(&b.centroid[axis]));
-    make_interior(prims, first, bounds, axis, mid, depth)
+    prims.select_nth_unstable_by(mid, |a, b| {
+        a.centroid2()[axis].total_cmp(&b.centroid2()[axis])
+    });
+    make_interior(prims, first, bounds, axis, mid, depth, None)
 }
 
+/// Builds the two halves `..mid` and `mid..` (in parallel when large), with their
+/// extents when the caller has them from its bins.
+#[allow(clippy::too_many_arguments)]
 fn make_interior(
     prims: &mut [PrimInfo],
     first: usize,
@@ -314,18 +411,20 @@ fn make_interior(
     axis: usize,
     mid: usize,
     depth: usize,
+    extents: Option<(Extents, Extents)>,
 ) -> BuildNode {
     let n = prims.len();
     let (left, right) = prims.split_at_mut(mid);
+    let (el, er) = extents.unwrap_or_else(|| (Extents::of(left), Extents::of(right)));
     let (a, b) = if n > PARALLEL_THRESHOLD {
         rayon::join(
-            || build_recursive(left, first, depth + 1),
-            || build_recursive(right, first + mid, depth + 1),
+            || build_recursive(left, first, depth + 1, el),
+            || build_recursive(right, first + mid, depth + 1, er),
         )
     } else {
         (
-            build_recursive(left, first, depth + 1),
-            build_recursive(right, first + mid, depth + 1),
+            build_recursive(left, first, depth + 1, el),
+            build_recursive(right, first + mid, depth + 1, er),
         )
     };
     let size = 1 + a.node_count() + b.node_count();
@@ -352,6 +451,7 @@ fn partition(prims: &mut [PrimInfo], pred: impl Fn(&PrimInfo) -> bool) -> usize 
 mod tests {
     use super::*;
     use crate::sampler::Pcg32;
+    use glam::Vec3;
 
     fn random_boxes(n: usize, rng: &mut Pcg32) -> Vec<Aabb> {
         (0..n)
