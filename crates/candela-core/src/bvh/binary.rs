@@ -5,6 +5,8 @@
 
 use glam::Vec3A;
 
+use super::extents::{Box3A, Extents, PrimInfo};
+
 use super::box4::T_MAX_SCALE;
 use crate::geometry::{Aabb, Ray};
 
@@ -59,87 +61,6 @@ impl BuildNode {
             BuildNode::Leaf { .. } => 1,
             BuildNode::Interior { size, .. } => *size,
         }
-    }
-}
-
-/// A primitive's box during the build, in SIMD vectors. Centroids are kept doubled
-/// (`min + max`), which bins exactly as the centroid does and saves a multiply.
-#[derive(Clone, Copy)]
-struct PrimInfo {
-    min: Vec3A,
-    max: Vec3A,
-    index: u32,
-}
-
-impl PrimInfo {
-    #[inline(always)]
-    fn centroid2(&self) -> Vec3A {
-        self.min + self.max
-    }
-}
-
-/// A box in SIMD vectors, for the build's many unions.
-#[derive(Clone, Copy)]
-struct Box3A {
-    min: Vec3A,
-    max: Vec3A,
-}
-
-impl Box3A {
-    const EMPTY: Box3A = Box3A {
-        min: Vec3A::INFINITY,
-        max: Vec3A::NEG_INFINITY,
-    };
-
-    #[inline(always)]
-    fn grow(&mut self, p: Vec3A) {
-        self.min = self.min.min(p);
-        self.max = self.max.max(p);
-    }
-
-    #[inline(always)]
-    fn union(&mut self, min: Vec3A, max: Vec3A) {
-        self.min = self.min.min(min);
-        self.max = self.max.max(max);
-    }
-
-    fn aabb(&self) -> Aabb {
-        Aabb {
-            min: self.min.into(),
-            max: self.max.into(),
-        }
-    }
-}
-
-/// What every node of the build knows of its primitives: their boxes' bounds and the
-/// bounds of their (doubled) centroids, both gathered by the parent's binning pass.
-#[derive(Clone, Copy)]
-struct Extents {
-    bounds: Box3A,
-    centroids: Box3A,
-}
-
-impl Extents {
-    fn of(prims: &[PrimInfo]) -> Extents {
-        let mut e = Extents {
-            bounds: Box3A::EMPTY,
-            centroids: Box3A::EMPTY,
-        };
-        for p in prims {
-            e.add(p);
-        }
-        e
-    }
-
-    #[inline(always)]
-    fn add(&mut self, p: &PrimInfo) {
-        self.bounds.union(p.min, p.max);
-        self.centroids.grow(p.centroid2());
-    }
-
-    fn merge(&mut self, o: &Extents) {
-        self.bounds.union(o.bounds.min, o.bounds.max);
-        self.centroids.union(o.centroids.min, o.centroids.max);
     }
 }
 

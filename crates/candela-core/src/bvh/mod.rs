@@ -13,6 +13,7 @@
 
 mod binary;
 mod box4;
+mod extents;
 mod wide;
 
 pub use binary::{Bvh, BvhNode};
