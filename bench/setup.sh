@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Sets up everything the benchmarks need beyond the Rust toolchain:
 #   * bench/.venv (git-ignored) with mitsuba, drjit and numpy (Mitsuba's own mi.Bitmap
-#     reads and writes EXR, so no separate OpenEXR binding is needed);
+#     reads and writes EXR, so no separate OpenEXR binding is needed), and embreex
+#     (Embree 4) for bench/traversal.sh;
 #   * Debian's LLVM shared library for Mitsuba's `llvm_ad_rgb` variant (Dr.Jit loads it at
 #     run time through DRJIT_LIBLLVM_PATH). `scalar_rgb` needs nothing.
 # Idempotent: every step checks whether its result is already there. Safe to re-run.
@@ -32,6 +33,15 @@ if ! "$venv/bin/python" -c "import mitsuba, numpy; assert mitsuba.__version__ ==
     "$venv/bin/python" -m pip install --quiet "mitsuba==$MITSUBA_VERSION" numpy
 else
     log "mitsuba $MITSUBA_VERSION and numpy already in $venv"
+fi
+
+# --- Embree 4 for bench/traversal.sh ----------------------------------------------
+# embreex ships Embree 4 inside its wheel, so nothing else is needed.
+if ! "$venv/bin/python" -c "import embreex" 2>/dev/null; then
+    log "installing embreex into $venv"
+    "$venv/bin/python" -m pip install --quiet embreex
+else
+    log "embreex already in $venv"
 fi
 
 # --- LLVM for llvm_ad_rgb -----------------------------------------------------------

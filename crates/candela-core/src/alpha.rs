@@ -1,9 +1,11 @@
 //! Alpha-tested (glTF `MASK`) and alpha-blended (glTF `BLEND`) surfaces: the one place
 //! that decides whether a ray passes through a triangle it hit.
 //!
-//! The ray queries ([`Scene::intersect`], [`Scene::occluded`]) call
-//! [`Scene::alpha_rejects`] from their triangle test; a rejected hit is as if the triangle
-//! were not there, so camera rays, bounce rays and shadow rays all see the same cut-out.
+//! The ray queries ([`Scene::intersect`], [`Scene::occluded`]) hand
+//! [`Scene::alpha_accepts`] to the acceleration structure as its filter, which calls it
+//! only for triangles of masked meshes (flagged at build); a rejected hit is as if the
+//! triangle were not there, so camera rays, bounce rays and shadow rays all see the same
+//! cut-out.
 //!
 //! - `Mask`: the surface is there where α ≥ cutoff and absent elsewhere (a threshold, as
 //!   the glTF 2.0 specification §3.9.4 prescribes).
@@ -18,9 +20,9 @@
 
 use glam::Vec2;
 
-use crate::geometry::Ray;
+use crate::geometry::{Ray, TriangleHit};
 use crate::sampler::mix64;
-use crate::scene::{Mesh, Scene};
+use crate::scene::{Mesh, Prim, Scene};
 use crate::texture::Texture;
 
 /// How a mesh's α hides it.
@@ -89,6 +91,18 @@ impl Scene {
         match &m.alpha {
             None => false,
             Some(alpha) => alpha.rejects(m.uv_at(tri, bary), hit_uniform(ray, mesh, tri)),
+        }
+    }
+
+    /// The acceleration structure's filter: whether `hit` on primitive `prim` (an index
+    /// into [`Scene::prims`]) counts.
+    #[inline]
+    pub fn alpha_accepts(&self, prim: u32, hit: &TriangleHit, ray: &Ray) -> bool {
+        match self.prims[prim as usize] {
+            Prim::Triangle { mesh, tri } => {
+                !self.alpha_rejects(mesh, tri, Vec2::new(hit.b1, hit.b2), ray)
+            }
+            Prim::Sphere(_) => true,
         }
     }
 }

@@ -7,11 +7,11 @@ use std::fmt;
 
 use glam::{Mat3, Mat4, Vec2, Vec3};
 
+use crate::accel::{Accel, Shape};
 use crate::alpha::{AlphaMask, AlphaMode};
 use crate::bsdf::{
     Conductor, ConductorFresnel, Dielectric, Lobe, Plastic, ThinDielectric, TrowbridgeReitz,
 };
-use crate::bvh::Bvh;
 use crate::camera::Camera;
 use crate::desc::{
     ApertureDesc, ApertureSizeDesc, BsdfDesc, CameraDesc, EnvironmentDesc, EnvironmentMapDesc,
@@ -167,25 +167,29 @@ pub fn build(desc: &SceneDesc) -> Result<Scene, BuildError> {
     }
 
     let mut prims = Vec::new();
-    let mut boxes = Vec::new();
+    let mut shapes = Vec::new();
     for (mi, m) in meshes.iter().enumerate() {
         for tri in 0..m.indices.len() as u32 {
             prims.push(Prim::Triangle {
                 mesh: mi as u32,
                 tri,
             });
-            boxes.push(Aabb::from_points(&m.vertices(tri)));
+            shapes.push(Shape::Triangle(m.vertices(tri)));
         }
     }
     for (si, s) in spheres.iter().enumerate() {
         prims.push(Prim::Sphere(si as u32));
-        boxes.push(Aabb {
-            min: s.center - Vec3::splat(s.radius),
-            max: s.center + Vec3::splat(s.radius),
+        shapes.push(Shape::Sphere {
+            center: s.center,
+            radius: s.radius,
         });
     }
-    let bvh = Bvh::build(&boxes);
-    let bounds = boxes.iter().copied().reduce(Aabb::union);
+    // Only triangles of alpha-masked meshes pay for the filter.
+    let accel = Accel::build(&shapes, |i| match prims[i as usize] {
+        Prim::Triangle { mesh, .. } => meshes[mesh as usize].alpha.is_some(),
+        Prim::Sphere(_) => false,
+    });
+    let bounds = shapes.iter().map(Shape::bounds).reduce(Aabb::union);
     let scene_radius = bounds.map_or(1.0, |b| (0.5 * (b.max - b.min).length()).max(1e-3));
     for light in &mut lights {
         if let Light::Directional(d) = light {
@@ -214,7 +218,7 @@ pub fn build(desc: &SceneDesc) -> Result<Scene, BuildError> {
         infinite_lights,
         light_sampler,
         prims,
-        bvh,
+        accel,
     })
 }
 

@@ -114,11 +114,14 @@ pub struct TriangleHit {
 /// Per-ray constants of the watertight triangle test.
 #[derive(Clone, Copy, Debug)]
 pub struct WatertightRay {
-    o: Vec3,
-    kx: usize,
-    ky: usize,
-    kz: usize,
-    shear: Vec3,
+    pub(crate) o: Vec3,
+    /// The axis along which the direction is largest is `kz`; `kx`, `ky` the others, in
+    /// the order that keeps the winding.
+    pub(crate) kx: usize,
+    pub(crate) ky: usize,
+    pub(crate) kz: usize,
+    /// (d[kx]/d[kz], d[ky]/d[kz], 1/d[kz]).
+    pub(crate) shear: Vec3,
 }
 
 impl WatertightRay {

@@ -27,6 +27,7 @@
 //! assert_eq!(result.film.resolve()[4 * 8 + 4], Vec3::ONE); // the centre pixel sees the sphere
 //! ```
 
+pub mod accel;
 pub mod alpha;
 pub mod bsdf;
 pub mod build;

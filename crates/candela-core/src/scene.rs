@@ -3,11 +3,11 @@
 
 use glam::{Vec2, Vec3};
 
-use crate::bvh::Bvh;
+use crate::accel::Accel;
 use crate::camera::Camera;
 use crate::desc::RenderSettings;
 use crate::filter::PixelFilter;
-use crate::geometry::{intersect_sphere, Aabb, Ray, WatertightRay};
+use crate::geometry::{Aabb, Ray};
 use crate::light::{Light, LightId};
 use crate::light_sampler::LightSampler;
 use crate::material::{Material, MaterialId};
@@ -121,13 +121,14 @@ pub struct Scene {
     /// Lights that escaped rays see.
     pub infinite_lights: Vec<LightId>,
     pub light_sampler: LightSampler,
+    /// Every primitive, in the order of [`Scene::accel`]'s primitive indices.
     pub prims: Vec<Prim>,
-    pub bvh: Bvh,
+    pub accel: Accel,
 }
 
 impl Scene {
     pub fn bounds(&self) -> Aabb {
-        self.bvh.bounds()
+        self.accel.bounds()
     }
 
     pub fn triangle_count(&self) -> usize {
@@ -140,46 +141,17 @@ impl Scene {
 
     /// The nearest surface along the ray within (0, t_max).
     pub fn intersect(&self, ray: &Ray, t_max: f32) -> Option<SurfaceInteraction> {
-        let wray = WatertightRay::new(ray);
-        let mut bary = Vec2::ZERO;
-        let (prim, t) =
-            self.bvh
-                .intersect(ray, t_max, |i, t_max| match self.prims[i as usize] {
-                    Prim::Triangle { mesh, tri } => {
-                        let [p0, p1, p2] = self.meshes[mesh as usize].vertices(tri);
-                        let hit = wray.intersect(p0, p1, p2, t_max)?;
-                        let b = Vec2::new(hit.b1, hit.b2);
-                        if self.alpha_rejects(mesh, tri, b, ray) {
-                            return None;
-                        }
-                        bary = b;
-                        Some(hit.t)
-                    }
-                    Prim::Sphere(s) => {
-                        let s = &self.spheres[s as usize];
-                        intersect_sphere(ray, s.center, s.radius, t_max)
-                    }
-                })?;
-        // Barycentrics belong to the last primitive that narrowed the search: the nearest.
-        Some(self.interaction(ray, self.prims[prim as usize], t, bary))
+        let hit = self
+            .accel
+            .intersect(ray, t_max, |i, hit| self.alpha_accepts(i, hit, ray))?;
+        let prim = self.prims[hit.prim as usize];
+        Some(self.interaction(ray, prim, hit.t, Vec2::new(hit.b1, hit.b2)))
     }
 
     /// Whether anything lies on the ray within (0, t_max).
     pub fn occluded(&self, ray: &Ray, t_max: f32) -> bool {
-        let wray = WatertightRay::new(ray);
-        self.bvh
-            .occluded(ray, t_max, |i, t_max| match self.prims[i as usize] {
-                Prim::Triangle { mesh, tri } => {
-                    let [p0, p1, p2] = self.meshes[mesh as usize].vertices(tri);
-                    wray.intersect(p0, p1, p2, t_max).is_some_and(|hit| {
-                        !self.alpha_rejects(mesh, tri, Vec2::new(hit.b1, hit.b2), ray)
-                    })
-                }
-                Prim::Sphere(s) => {
-                    let s = &self.spheres[s as usize];
-                    intersect_sphere(ray, s.center, s.radius, t_max).is_some()
-                }
-            })
+        self.accel
+            .occluded(ray, t_max, |i, hit| self.alpha_accepts(i, hit, ray))
     }
 
     /// Whether the segment from surface point `from` (normal `n_from`) to point `to`

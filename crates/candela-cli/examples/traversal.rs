@@ -1,0 +1,306 @@
+//! The ray-traversal benchmark behind `bench/traversal.sh` (not run by CI).
+//!
+//! `traversal rays SCENE OUT_DIR [RAYS]` makes a triangle soup and diffuse-bounce rays and
+//! times Candela's closest-hit and any-hit queries on them, single-threaded:
+//! - `SCENE` is `cornell` (scenes/cornell.toml, its camera) or `room` (a generated room of
+//!   16 displaced spheres, 589 836 triangles, seen from inside);
+//! - rays: one primary ray per jittered pixel sample, and from each primary hit a
+//!   cosine-distributed bounce ray about the geometric normal, origin offset as the
+//!   renderer does; only the bounce rays are timed and written.
+//!
+//! OUT_DIR receives `tris.f32` (9 floats a triangle), `rays.f32` (origin, direction),
+//! `candela_hits.bin` (per ray: u32 triangle or u32::MAX, f32 t) for
+//! `bench/traversal.py`, which traces the same rays with Embree and compares.
+//!
+//! `traversal build [TRIANGLES]` times the BVH build of a generated displaced-sphere mesh
+//! (default 10⁶ triangles) on the rayon pool (`RAYON_NUM_THREADS=2` for two cores).
+
+use std::io::Write;
+use std::path::Path;
+use std::time::Instant;
+
+use candela_core::accel::{accept_all, Accel, Shape};
+use candela_core::geometry::Ray;
+use candela_core::math::{offset_ray_origin, Frame};
+use candela_core::sampler::Pcg32;
+use candela_core::sampling::sample_cosine_hemisphere;
+use glam::{Vec2, Vec3};
+
+fn main() {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    match args.first().map(String::as_str) {
+        Some("rays") if args.len() >= 3 => {
+            let rays = args.get(3).map_or(1 << 20, |s| s.parse().expect("RAYS"));
+            rays_bench(&args[1], Path::new(&args[2]), rays);
+        }
+        Some("build") => {
+            let n = args
+                .get(1)
+                .map_or(1_000_000, |s| s.parse().expect("TRIANGLES"));
+            build_bench(n);
+        }
+        _ => {
+            eprintln!(
+                "usage: traversal rays cornell|room OUT_DIR [RAYS] | traversal build [TRIANGLES]"
+            );
+            std::process::exit(2);
+        }
+    }
+}
+
+/// A displaced UV sphere: `n_phi` × `n_theta` quads, radius modulated by a sum of sines
+/// so that the surface is bumpy at several scales (triangles of all orientations).
+fn displaced_sphere(
+    center: Vec3,
+    radius: f32,
+    n_phi: usize,
+    n_theta: usize,
+    seed: f32,
+) -> Vec<[Vec3; 3]> {
+    let point = |i: usize, j: usize| {
+        let phi = std::f32::consts::TAU * i as f32 / n_phi as f32;
+        let theta = std::f32::consts::PI * j as f32 / n_theta as f32;
+        let d = Vec3::new(
+            theta.sin() * phi.cos(),
+            theta.cos(),
+            theta.sin() * phi.sin(),
+        );
+        let bump = 0.08 * (7.0 * phi + seed).sin() * (5.0 * theta).sin()
+            + 0.03 * (23.0 * phi).sin() * (19.0 * theta + seed).cos()
+            + 0.01 * (71.0 * phi + 2.0 * seed).sin() * (67.0 * theta).sin();
+        center + d * radius * (1.0 + bump)
+    };
+    let mut tris = Vec::with_capacity(2 * n_phi * n_theta);
+    for i in 0..n_phi {
+        for j in 0..n_theta {
+            let (a, b) = (point(i, j), point(i + 1, j));
+            let (c, d) = (point(i + 1, j + 1), point(i, j + 1));
+            tris.push([a, b, c]);
+            tris.push([a, c, d]);
+        }
+    }
+    tris
+}
+
+/// A 20 × 8 × 20 room (floor at y = 0) with a 4 × 4 grid of displaced spheres.
+fn room(n_phi: usize, n_theta: usize) -> Vec<[Vec3; 3]> {
+    let (lo, hi) = (Vec3::new(-10.0, 0.0, -10.0), Vec3::new(10.0, 8.0, 10.0));
+    let c =
+        |x: usize, y: usize, z: usize| Vec3::new([lo.x, hi.x][x], [lo.y, hi.y][y], [lo.z, hi.z][z]);
+    let mut tris = Vec::new();
+    // Two triangles for each face of the box.
+    for (a, b, cc, d) in [
+        (c(0, 0, 0), c(1, 0, 0), c(1, 0, 1), c(0, 0, 1)),
+        (c(0, 1, 0), c(0, 1, 1), c(1, 1, 1), c(1, 1, 0)),
+        (c(0, 0, 0), c(0, 0, 1), c(0, 1, 1), c(0, 1, 0)),
+        (c(1, 0, 0), c(1, 1, 0), c(1, 1, 1), c(1, 0, 1)),
+        (c(0, 0, 0), c(0, 1, 0), c(1, 1, 0), c(1, 0, 0)),
+        (c(0, 0, 1), c(1, 0, 1), c(1, 1, 1), c(0, 1, 1)),
+    ] {
+        tris.push([a, b, cc]);
+        tris.push([a, cc, d]);
+    }
+    for i in 0..4 {
+        for k in 0..4 {
+            let center = Vec3::new(
+                -6.0 + 4.0 * i as f32,
+                1.6 + 0.5 * ((i + k) % 3) as f32,
+                -6.0 + 4.0 * k as f32,
+            );
+            tris.extend(displaced_sphere(
+                center,
+                1.4,
+                n_phi,
+                n_theta,
+                (4 * i + k) as f32,
+            ));
+        }
+    }
+    tris
+}
+
+fn shapes(tris: &[[Vec3; 3]]) -> Vec<Shape> {
+    tris.iter().map(|&t| Shape::Triangle(t)).collect()
+}
+
+fn normal(t: &[Vec3; 3]) -> Vec3 {
+    (t[1] - t[0]).cross(t[2] - t[0]).normalize_or_zero()
+}
+
+/// Film position in [0, 1)² to primary ray.
+type CameraFn = Box<dyn Fn(Vec2) -> Ray>;
+
+fn rays_bench(scene: &str, out: &Path, n_rays: usize) {
+    let (tris, camera): (Vec<[Vec3; 3]>, CameraFn) = match scene {
+        "cornell" => {
+            let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../../scenes/cornell.toml");
+            let mut desc = candela_scene::load_scene(Path::new(path)).expect("cornell.toml");
+            desc.render.width = 512;
+            desc.render.height = 512;
+            let scene = candela_core::build::build(&desc).expect("cornell builds");
+            assert!(
+                scene.spheres.is_empty(),
+                "the benchmark traces triangles only"
+            );
+            let tris = scene
+                .meshes
+                .iter()
+                .flat_map(|m| (0..m.indices.len() as u32).map(move |t| m.vertices(t)))
+                .collect();
+            let cam = scene.camera.clone();
+            (tris, Box::new(move |f: Vec2| cam.generate_ray(f * 512.0)))
+        }
+        "room" => {
+            // A pinhole in a corner looking at the middle of the room, 60° field of view.
+            let (eye, target) = (Vec3::new(-9.0, 6.0, 9.0), Vec3::new(0.0, 1.5, 0.0));
+            let frame = Frame::from_z((eye - target).normalize());
+            let tan = (30f32).to_radians().tan();
+            let cam = move |f: Vec2| {
+                let d = Vec3::new((2.0 * f.x - 1.0) * tan, (1.0 - 2.0 * f.y) * tan, -1.0);
+                Ray::new(eye, frame.to_world(d).normalize())
+            };
+            (room(192, 96), Box::new(cam))
+        }
+        other => panic!("unknown scene {other:?}: cornell or room"),
+    };
+    let t0 = Instant::now();
+    let accel = Accel::build(&shapes(&tris), |_| false);
+    let build_s = t0.elapsed().as_secs_f64();
+
+    // Diffuse-bounce rays from primary hits.
+    let mut rng = Pcg32::new(7, 0);
+    let mut rays = Vec::with_capacity(n_rays);
+    while rays.len() < n_rays {
+        let film = Vec2::new(rng.uniform_f32(), rng.uniform_f32());
+        let primary = camera(film);
+        let Some(hit) = accel.intersect(&primary, f32::INFINITY, accept_all) else {
+            continue;
+        };
+        let tri = &tris[hit.prim as usize];
+        let mut n = normal(tri);
+        if n.dot(primary.d) > 0.0 {
+            n = -n;
+        }
+        let p = tri[0] * (1.0 - hit.b1 - hit.b2) + tri[1] * hit.b1 + tri[2] * hit.b2;
+        let d = Frame::from_z(n).to_world(sample_cosine_hemisphere(Vec2::new(
+            rng.uniform_f32(),
+            rng.uniform_f32(),
+        )));
+        rays.push(Ray::new(offset_ray_origin(p, n), d.normalize()));
+    }
+
+    let mut hits = vec![(u32::MAX, f32::INFINITY); rays.len()];
+    let closest = best_of(3, || {
+        for (r, h) in rays.iter().zip(hits.iter_mut()) {
+            if let Some(hit) = accel.intersect(r, f32::INFINITY, accept_all) {
+                *h = (hit.prim, hit.t);
+            }
+        }
+    });
+    let mut blocked = 0;
+    let any = best_of(3, || {
+        blocked = rays
+            .iter()
+            .filter(|r| accel.occluded(r, f32::INFINITY, accept_all))
+            .count();
+    });
+    let found = hits.iter().filter(|h| h.0 != u32::MAX).count();
+    assert_eq!(
+        found, blocked,
+        "closest-hit and any-hit agree on which rays hit"
+    );
+
+    std::fs::create_dir_all(out).expect("OUT_DIR");
+    let floats =
+        |v: &mut dyn Iterator<Item = f32>| -> Vec<u8> { v.flat_map(f32::to_le_bytes).collect() };
+    std::fs::write(
+        out.join("tris.f32"),
+        floats(&mut tris.iter().flatten().flat_map(|v| v.to_array())),
+    )
+    .unwrap();
+    std::fs::write(
+        out.join("rays.f32"),
+        floats(
+            &mut rays
+                .iter()
+                .flat_map(|r| [r.o.to_array(), r.d.to_array()].concat()),
+        ),
+    )
+    .unwrap();
+    let mut f = std::fs::File::create(out.join("candela_hits.bin")).unwrap();
+    for (prim, t) in &hits {
+        f.write_all(&prim.to_le_bytes()).unwrap();
+        f.write_all(&t.to_le_bytes()).unwrap();
+    }
+    let n = rays.len() as f64;
+    println!(
+        "{{\"scene\": \"{scene}\", \"triangles\": {}, \"rays\": {}, \"hit\": {found}, \"build_s\": {build_s:.4}, \
+         \"closest_mrays_s\": {:.3}, \"any_mrays_s\": {:.3}}}",
+        tris.len(),
+        rays.len(),
+        n / closest / 1e6,
+        n / any / 1e6
+    );
+}
+
+/// The fastest of `runs` timings of `f`, in seconds: the least disturbed by other load.
+fn best_of(runs: usize, mut f: impl FnMut()) -> f64 {
+    (0..runs)
+        .map(|_| {
+            let t = Instant::now();
+            f();
+            t.elapsed().as_secs_f64()
+        })
+        .fold(f64::INFINITY, f64::min)
+}
+
+fn build_bench(n: usize) {
+    // 25 displaced spheres sized to give at least n triangles.
+    let per = n.div_ceil(25);
+    let n_theta = ((per as f64 / 4.0).sqrt().ceil() as usize).max(2);
+    let n_phi = per.div_ceil(2 * n_theta);
+    let mut tris = Vec::new();
+    for i in 0..5 {
+        for k in 0..5 {
+            let c = Vec3::new(3.0 * i as f32, 0.0, 3.0 * k as f32);
+            tris.extend(displaced_sphere(c, 1.4, n_phi, n_theta, (5 * i + k) as f32));
+        }
+    }
+    let shapes = shapes(&tris);
+    let threads = rayon::current_num_threads();
+    let mut times: Vec<(f64, f64)> = (0..5)
+        .map(|_| {
+            let (t, cpu) = (Instant::now(), cpu_seconds());
+            let accel = Accel::build(&shapes, |_| false);
+            let s = (t.elapsed().as_secs_f64(), cpu_seconds() - cpu);
+            assert!(!accel.bounds().is_empty());
+            s
+        })
+        .collect();
+    times.sort_by(|a, b| a.0.total_cmp(&b.0));
+    println!(
+        "{{\"triangles\": {}, \"threads\": {threads}, \"build_best_s\": {:.3}, \"build_median_s\": {:.3}, \
+         \"cpu_s_of_best\": {:.2}}}",
+        tris.len(),
+        times[0].0,
+        times[2].0,
+        times[0].1
+    );
+}
+
+/// CPU time of this process, all threads (Linux /proc; 0 elsewhere): on a loaded
+/// machine wall time says little, CPU time shows the work.
+fn cpu_seconds() -> f64 {
+    let Ok(stat) = std::fs::read_to_string("/proc/self/stat") else {
+        return 0.0;
+    };
+    // Fields after the parenthesised command name; utime and stime are the 12th and 13th.
+    let rest = &stat[stat.rfind(')').map_or(0, |i| i + 2)..];
+    let f: Vec<f64> = rest
+        .split(' ')
+        .skip(11)
+        .take(2)
+        .filter_map(|x| x.parse().ok())
+        .collect();
+    f.iter().sum::<f64>() / 100.0
+}

@@ -1,0 +1,147 @@
+//! The ray-tracing acceleration structure: a [`WideBvh`] over the scene's primitives,
+//! each leaf's primitives copied into one [`block::Block`] of four lanes with the
+//! vertices inline (no index → mesh → position chase), tested four at a time.
+//!
+//! Triangles keep the watertight test (Woop et al. 2013) on the same vertex values as
+//! the meshes, so a hit's distance is the same bits as the mesh's own test gives. Each
+//! primitive carries flag bits: a sphere, or a triangle whose hits must pass a filter
+//! (alpha masks). Blocks without flags never call the filter; a flagged triangle calls
+//! it after its barycentrics are known, and traversal goes on past it when the filter
+//! rejects.
+
+mod block;
+
+use glam::Vec3;
+
+use crate::bvh::{Bvh, WideBvh};
+use crate::geometry::{Aabb, Ray, TriangleHit, WatertightRay};
+use block::{Block, FILTERED, ID_MASK, SPHERE};
+
+/// A primitive handed to [`Accel::build`].
+#[derive(Clone, Copy, Debug)]
+pub enum Shape {
+    Triangle([Vec3; 3]),
+    Sphere { center: Vec3, radius: f32 },
+}
+
+impl Shape {
+    pub fn bounds(&self) -> Aabb {
+        match *self {
+            Shape::Triangle(v) => Aabb::from_points(&v),
+            Shape::Sphere { center, radius } => Aabb {
+                min: center - Vec3::splat(radius),
+                max: center + Vec3::splat(radius),
+            },
+        }
+    }
+}
+
+/// What a ray hit: the primitive's index in the list given to [`Accel::build`], the
+/// distance, and for a triangle the barycentrics of its vertices 1 and 2.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Hit {
+    pub prim: u32,
+    pub t: f32,
+    pub b1: f32,
+    pub b2: f32,
+}
+
+/// Accepts every hit: the filter of scenes without alpha masks.
+pub fn accept_all(_: u32, _: &TriangleHit) -> bool {
+    true
+}
+
+#[derive(Clone, Debug, Default)]
+pub struct Accel {
+    bvh: WideBvh,
+    blocks: Vec<Block>,
+}
+
+impl Accel {
+    /// Builds over `shapes`; `filtered(i)` says whether hits on triangle `i` must pass
+    /// the filter. Primitives with empty or non-finite boxes are left out.
+    pub fn build(shapes: &[Shape], filtered: impl Fn(u32) -> bool) -> Accel {
+        assert!(
+            shapes.len() < ID_MASK as usize,
+            "at most 2^30 primitives per scene"
+        );
+        let boxes: Vec<Aabb> = shapes.iter().map(Shape::bounds).collect();
+        let binary = Bvh::build(&boxes);
+        let record = |i: u32| match shapes[i as usize] {
+            Shape::Triangle(v) => (v, i | if filtered(i) { FILTERED } else { 0 }),
+            Shape::Sphere { center, radius } => (
+                [center, Vec3::new(radius, 0.0, 0.0), Vec3::ZERO],
+                i | SPHERE,
+            ),
+        };
+        // One block per binary leaf; wide leaves then point at blocks, not prim ranges.
+        let mut block_of = vec![u32::MAX; binary.prims.len()];
+        let mut blocks = Vec::new();
+        for node in binary.nodes.iter().filter(|n| n.is_leaf()) {
+            let first = node.offset as usize;
+            let prims = &binary.prims[first..first + node.count as usize];
+            block_of[first] = blocks.len() as u32;
+            blocks.push(Block::new(
+                &prims.iter().map(|&i| record(i)).collect::<Vec<_>>(),
+            ));
+        }
+        let mut bvh = WideBvh::collapse(&binary);
+        for node in &mut bvh.nodes {
+            for lane in 0..4 {
+                if node.count[lane] > 0 {
+                    node.child[lane] = block_of[node.child[lane] as usize];
+                }
+            }
+        }
+        Accel { bvh, blocks }
+    }
+
+    pub fn bounds(&self) -> Aabb {
+        self.bvh.bounds()
+    }
+
+    /// The nearest hit within (0, t_max); hits on flagged triangles count only where
+    /// `filter` accepts them.
+    #[inline]
+    pub fn intersect(
+        &self,
+        ray: &Ray,
+        t_max: f32,
+        filter: impl Fn(u32, &TriangleHit) -> bool,
+    ) -> Option<Hit> {
+        let wray = WatertightRay::new(ray);
+        let mut best: Option<Hit> = None;
+        self.bvh.intersect(ray, t_max, |block, count, t_max| {
+            match self.blocks[block as usize].intersect(ray, &wray, count, t_max, &filter) {
+                Some(h) => {
+                    best = Some(Hit {
+                        prim: h.id,
+                        t: h.hit.t,
+                        b1: h.hit.b1,
+                        b2: h.hit.b2,
+                    });
+                    h.hit.t
+                }
+                None => t_max,
+            }
+        });
+        best
+    }
+
+    /// Whether anything accepted by `filter` lies on the ray within (0, t_max); stops
+    /// at the first blocker found.
+    #[inline]
+    pub fn occluded(
+        &self,
+        ray: &Ray,
+        t_max: f32,
+        filter: impl Fn(u32, &TriangleHit) -> bool,
+    ) -> bool {
+        let wray = WatertightRay::new(ray);
+        self.bvh.occluded(ray, t_max, |block, count, t_max| {
+            self.blocks[block as usize]
+                .intersect(ray, &wray, count, t_max, &filter)
+                .is_some()
+        })
+    }
+}

@@ -1,0 +1,334 @@
+//! The wide BVH against the references it replaces: on random rays through random and
+//! degenerate scenes, `Accel` must find the same nearest primitive at the same distance,
+//! bit for bit, as a brute-force loop and as the binary BVH's own traversal (the one the
+//! scene used before), with the same triangle and sphere tests; any-hit queries must give
+//! the same answers. Ties (two primitives at the same distance, e.g. a ray through a
+//! shared edge) may resolve to either, so there the found primitive is checked to give
+//! the same distance. No statistics: every ray must agree.
+//!
+//! The alpha-mask path: flagging every other triangle and rejecting it in the filter must
+//! give the same hits as building without those triangles.
+
+use candela_core::accel::{accept_all, Accel, Hit, Shape};
+use candela_core::bvh::Bvh;
+use candela_core::geometry::{intersect_sphere, Aabb, Ray, WatertightRay};
+use candela_core::sampler::Pcg32;
+use glam::Vec3;
+
+fn v3(rng: &mut Pcg32) -> Vec3 {
+    Vec3::new(rng.uniform_f32(), rng.uniform_f32(), rng.uniform_f32())
+}
+
+/// Distance at which `shape` is hit before `t_max`, with the renderer's tests.
+fn test_shape(shape: &Shape, ray: &Ray, t_max: f32) -> Option<f32> {
+    match *shape {
+        Shape::Triangle([a, b, c]) => WatertightRay::new(ray)
+            .intersect(a, b, c, t_max)
+            .map(|h| h.t),
+        Shape::Sphere { center, radius } => intersect_sphere(ray, center, radius, t_max),
+    }
+}
+
+fn brute_force(shapes: &[Shape], ray: &Ray, t_max: f32) -> Option<(u32, f32)> {
+    let mut best = None;
+    let mut t_max = t_max;
+    for (i, s) in shapes.iter().enumerate() {
+        if let Some(t) = test_shape(s, ray, t_max) {
+            t_max = t;
+            best = Some((i as u32, t));
+        }
+    }
+    best
+}
+
+fn boxes(shapes: &[Shape]) -> Vec<Aabb> {
+    shapes
+        .iter()
+        .map(|s| match *s {
+            Shape::Triangle(v) => Aabb::from_points(&v),
+            Shape::Sphere { center, radius } => Aabb {
+                min: center - Vec3::splat(radius),
+                max: center + Vec3::splat(radius),
+            },
+        })
+        .collect()
+}
+
+/// Random rays: origins in and around `bounds`, directions uniform, a quarter of them
+/// with one or two components exactly ±0 (axis-parallel), some aimed at a vertex.
+fn random_rays(rng: &mut Pcg32, shapes: &[Shape], bounds: Aabb, n: usize) -> Vec<Ray> {
+    let (lo, ext) = if bounds.is_empty() {
+        (Vec3::splat(-1.0), Vec3::splat(2.0))
+    } else {
+        let e = bounds.extent();
+        (bounds.min - 0.25 * e, 1.5 * e)
+    };
+    (0..n)
+        .map(|i| {
+            let o = lo + v3(rng) * ext;
+            let mut d = v3(rng) * 2.0 - 1.0;
+            match i % 8 {
+                0 => d.x = 0.0,
+                1 => {
+                    d.y = -0.0;
+                    d.z = 0.0
+                }
+                2 if !shapes.is_empty() => {
+                    // Straight at a vertex or sphere centre: edges and corners.
+                    let k = rng.next_u32() as usize % shapes.len();
+                    let target = match shapes[k] {
+                        Shape::Triangle(v) => v[rng.next_u32() as usize % 3],
+                        Shape::Sphere { center, .. } => center,
+                    };
+                    d = target - o;
+                }
+                _ => {}
+            }
+            if d == Vec3::ZERO {
+                d = Vec3::Y;
+            }
+            Ray::new(o, d.normalize_or(Vec3::Y))
+        })
+        .collect()
+}
+
+/// Checks every ray against brute force and the binary BVH; returns how many hit.
+fn check_scene(name: &str, shapes: &[Shape], rays: &[Ray], rng: &mut Pcg32) -> usize {
+    let accel = Accel::build(shapes, |_| false);
+    let binary = Bvh::build(&boxes(shapes));
+    let mut hits = 0;
+    for (k, ray) in rays.iter().enumerate() {
+        let t_max = if k % 3 == 0 {
+            rng.uniform_f32() * 4.0
+        } else {
+            f32::INFINITY
+        };
+        let brute = brute_force(shapes, ray, t_max);
+        let old = binary.intersect(ray, t_max, |i, t| test_shape(&shapes[i as usize], ray, t));
+        let new = accel.intersect(ray, t_max, accept_all);
+        let new_pt = new.map(|h: Hit| (h.prim, h.t));
+        for (what, reference) in [("brute force", brute), ("binary BVH", old)] {
+            match (new_pt, reference) {
+                (None, None) => {}
+                (Some((p, t)), Some((q, s))) => {
+                    assert_eq!(
+                        t.to_bits(),
+                        s.to_bits(),
+                        "{name}: ray {k} ({ray:?}): t {t} vs {what} {s}"
+                    );
+                    if p != q {
+                        let tie = test_shape(&shapes[p as usize], ray, f32::INFINITY);
+                        assert_eq!(
+                            tie.map(f32::to_bits),
+                            Some(s.to_bits()),
+                            "{name}: ray {k}: prim {p} vs {what} {q}, and not a tie"
+                        );
+                    }
+                }
+                _ => panic!("{name}: ray {k} ({ray:?}): {new_pt:?} vs {what} {reference:?}"),
+            }
+        }
+        assert_eq!(
+            accel.occluded(ray, t_max, accept_all),
+            brute.is_some(),
+            "{name}: ray {k}: any-hit disagrees"
+        );
+        hits += brute.is_some() as usize;
+    }
+    hits
+}
+
+fn random_soup(rng: &mut Pcg32, n: usize, spheres: usize) -> Vec<Shape> {
+    let mut s: Vec<Shape> = (0..n)
+        .map(|_| {
+            let c = v3(rng) * 10.0;
+            let size = 0.1 + 3.0 * rng.uniform_f32().powi(2);
+            Shape::Triangle([c, c + (v3(rng) - 0.5) * size, c + (v3(rng) - 0.5) * size])
+        })
+        .collect();
+    s.extend((0..spheres).map(|_| Shape::Sphere {
+        center: v3(rng) * 10.0,
+        radius: 0.05 + 0.5 * rng.uniform_f32(),
+    }));
+    s
+}
+
+/// A bumpy height field of `n`×`n` quads: triangles sharing edges and vertices.
+fn height_field(n: usize, scale: f32) -> Vec<Shape> {
+    let p = |i: usize, j: usize| {
+        let (x, z) = (i as f32 / n as f32, j as f32 / n as f32);
+        Vec3::new(x, 0.1 * (9.0 * x).sin() * (7.0 * z).cos(), z) * scale
+    };
+    let mut s = Vec::new();
+    for i in 0..n {
+        for j in 0..n {
+            s.push(Shape::Triangle([p(i, j), p(i + 1, j), p(i + 1, j + 1)]));
+            s.push(Shape::Triangle([p(i, j), p(i + 1, j + 1), p(i, j + 1)]));
+        }
+    }
+    s
+}
+
+fn bounds_of(shapes: &[Shape]) -> Aabb {
+    boxes(shapes)
+        .into_iter()
+        .filter(|b| b.min.is_finite() && b.max.is_finite())
+        .fold(Aabb::EMPTY, Aabb::union)
+}
+
+#[test]
+fn same_hits_as_brute_force_and_the_binary_bvh() {
+    let mut rng = Pcg32::new(2024, 1);
+    let mut scenes: Vec<(&str, Vec<Shape>)> = vec![
+        ("soup", random_soup(&mut rng, 3000, 60)),
+        ("height field", height_field(40, 5.0)),
+        ("huge scale", height_field(12, 1e12)),
+        ("tiny scale", height_field(12, 1e-12)),
+    ];
+    // Many copies of one triangle: coincident centroids, median splits.
+    let one = Shape::Triangle([Vec3::ZERO, Vec3::X, Vec3::Y]);
+    scenes.push(("coincident", vec![one; 300]));
+    // Positions at 2^-i: a maximally unbalanced SAH tree, deeper than the depth cap.
+    scenes.push((
+        "geometric",
+        (0..400)
+            .map(|i| {
+                let x = 0.97f32.powi(i);
+                Shape::Triangle([
+                    Vec3::new(x, 0.0, 0.0),
+                    Vec3::new(x, 1.0, 0.0),
+                    Vec3::new(x, 0.0, 1.0),
+                ])
+            })
+            .collect(),
+    ));
+    // Zero-area and non-finite triangles mixed with ordinary ones.
+    let mut degenerate = random_soup(&mut rng, 200, 5);
+    degenerate.push(Shape::Triangle([Vec3::ONE; 3]));
+    degenerate.push(Shape::Triangle([Vec3::ZERO, Vec3::ONE, Vec3::splat(2.0)]));
+    degenerate.push(Shape::Triangle([
+        Vec3::ZERO,
+        Vec3::X,
+        Vec3::splat(f32::NAN),
+    ]));
+    degenerate.push(Shape::Triangle([
+        Vec3::ZERO,
+        Vec3::X,
+        Vec3::new(0.0, f32::INFINITY, 0.0),
+    ]));
+    degenerate.push(Shape::Sphere {
+        center: Vec3::splat(3.0),
+        radius: 0.0,
+    });
+    scenes.push(("degenerate", degenerate));
+    scenes.push(("one triangle", vec![one]));
+    scenes.push(("empty", vec![]));
+
+    for (name, shapes) in &scenes {
+        let rays = random_rays(&mut rng, shapes, bounds_of(shapes), 6000);
+        let hits = check_scene(name, shapes, &rays, &mut rng);
+        eprintln!(
+            "{name}: {} shapes, {} rays, {hits} hit",
+            shapes.len(),
+            rays.len()
+        );
+        if !matches!(*name, "empty") {
+            assert!(hits > 100, "{name}: too few hits ({hits}) to test anything");
+        }
+    }
+}
+
+#[test]
+fn rays_inside_box_planes_and_non_finite_rays() {
+    // A unit cube of 12 triangles; rays lying exactly in its face planes, along the axes.
+    let c = |x: f32, y: f32, z: f32| Vec3::new(x, y, z);
+    let q = |a, b, cc, d| [Shape::Triangle([a, b, cc]), Shape::Triangle([a, cc, d])];
+    let mut cube = Vec::new();
+    for (a, b, cc, d) in [
+        (c(0., 0., 0.), c(1., 0., 0.), c(1., 0., 1.), c(0., 0., 1.)),
+        (c(0., 1., 0.), c(0., 1., 1.), c(1., 1., 1.), c(1., 1., 0.)),
+        (c(0., 0., 0.), c(0., 0., 1.), c(0., 1., 1.), c(0., 1., 0.)),
+        (c(1., 0., 0.), c(1., 1., 0.), c(1., 1., 1.), c(1., 0., 1.)),
+        (c(0., 0., 0.), c(0., 1., 0.), c(1., 1., 0.), c(1., 0., 0.)),
+        (c(0., 0., 1.), c(1., 0., 1.), c(1., 1., 1.), c(0., 1., 1.)),
+    ] {
+        cube.extend(q(a, b, cc, d));
+    }
+    let mut rays = Vec::new();
+    for i in 0..=8 {
+        for j in 0..=8 {
+            let (u, v) = (i as f32 / 8.0, j as f32 / 8.0);
+            for d in [Vec3::X, -Vec3::X, Vec3::Y, -Vec3::Y, Vec3::Z, -Vec3::Z] {
+                rays.push(Ray::new(
+                    Vec3::new(u, v, -1.0) * (1.0 - d.z.abs()) + Vec3::new(u, -1.0, v) * d.z.abs(),
+                    d,
+                ));
+                rays.push(Ray::new(Vec3::new(-0.5, u, v) + d * 0.0, d));
+            }
+        }
+    }
+    let mut rng = Pcg32::new(5, 5);
+    check_scene("cube planes", &cube, &rays, &mut rng);
+    let accel = Accel::build(&cube, |_| false);
+    for bad in [
+        Ray::new(Vec3::splat(f32::NAN), Vec3::X),
+        Ray::new(Vec3::splat(0.5), Vec3::splat(f32::NAN)),
+        Ray::new(Vec3::splat(f32::INFINITY), -Vec3::X),
+    ] {
+        assert!(accel.intersect(&bad, f32::INFINITY, accept_all).is_none());
+        assert!(!accel.occluded(&bad, f32::INFINITY, accept_all));
+    }
+}
+
+#[test]
+fn rejected_hits_are_as_if_the_triangles_were_not_there() {
+    let mut rng = Pcg32::new(77, 3);
+    let shapes = random_soup(&mut rng, 3000, 40);
+    let masked = |i: u32| i % 2 == 1 && matches!(shapes[i as usize], Shape::Triangle(_));
+    let with_filter = Accel::build(&shapes, masked);
+    let kept: Vec<u32> = (0..shapes.len() as u32).filter(|&i| !masked(i)).collect();
+    let without = Accel::build(
+        &kept.iter().map(|&i| shapes[i as usize]).collect::<Vec<_>>(),
+        |_| false,
+    );
+    let calls = std::cell::Cell::new(0usize);
+    let reject_odd = |i: u32, _: &_| {
+        calls.set(calls.get() + 1);
+        assert!(masked(i), "the filter is called only for flagged triangles");
+        false
+    };
+    let rays = random_rays(&mut rng, &shapes, bounds_of(&shapes), 8000);
+    let mut hits = 0;
+    for ray in &rays {
+        let a = with_filter.intersect(ray, f32::INFINITY, reject_odd);
+        let b = without.intersect(ray, f32::INFINITY, accept_all);
+        assert_eq!(
+            a.map(|h| (h.prim, h.t.to_bits())),
+            b.map(|h| (kept[h.prim as usize], h.t.to_bits()))
+        );
+        assert_eq!(
+            with_filter.occluded(ray, f32::INFINITY, reject_odd),
+            b.is_some()
+        );
+        hits += b.is_some() as usize;
+    }
+    assert!(hits > 1000, "only {hits} hits");
+    assert!(
+        calls.get() > 1000,
+        "filter called only {} times",
+        calls.get()
+    );
+    // Accepting everything is the same as no flags at all.
+    let plain = Accel::build(&shapes, |_| false);
+    for ray in &rays {
+        assert_eq!(
+            with_filter.intersect(ray, f32::INFINITY, accept_all),
+            plain.intersect(ray, f32::INFINITY, accept_all)
+        );
+    }
+    eprintln!(
+        "{} rays, {hits} hit, filter called {} times",
+        rays.len(),
+        calls.get()
+    );
+}
