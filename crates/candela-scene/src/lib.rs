@@ -35,6 +35,7 @@ use candela_core::desc::{MeshDesc, SceneDesc, Span};
 
 pub mod environment;
 pub mod image_texture;
+pub mod limits;
 pub mod obj;
 pub mod ply;
 mod toml_camera;

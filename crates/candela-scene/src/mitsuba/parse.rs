@@ -204,13 +204,23 @@ pub(crate) fn is_property(tag: &str) -> bool {
 /// Parses a scene file (and what it includes) into its `<scene>` node. `defines` are the
 /// `-D name=value` parameters, which take precedence over `<default>`s.
 pub(crate) fn parse_file(path: &Path, defines: &[(String, String)]) -> Result<Node, LoadError> {
-    let mut p = Parser {
-        params: defines.iter().cloned().collect(),
-    };
     let span = Span::new(path.display().to_string(), 1, 1);
     let text = std::fs::read_to_string(path)
         .map_err(|e| LoadError::new(span, format!("cannot read scene file: {e}")))?;
-    p.parse_text(path, &text, 0)
+    parse_str(&text, path, defines)
+}
+
+/// Parses a scene's text into its `<scene>` node; `path` names it in errors and is where
+/// `<include>`d files are looked up.
+pub(crate) fn parse_str(
+    text: &str,
+    path: &Path,
+    defines: &[(String, String)],
+) -> Result<Node, LoadError> {
+    let mut p = Parser {
+        params: defines.iter().cloned().collect(),
+    };
+    p.parse_text(path, text, 0)
 }
 
 struct Parser {
