@@ -66,6 +66,9 @@ fn assert_user_error(o: &Output, needles: &[&str]) {
     }
 }
 
+/// A scene addition, the file it refers to (name, bytes), and what its error must hold.
+type Case<'a> = (String, (&'a str, &'a [u8]), Vec<&'a str>);
+
 const MESH_SHAPE: &str = "[[shape]]\ntype = \"mesh\"\nfile = \"FILE\"\nmaterial = \"white\"\n";
 
 #[test]
@@ -74,7 +77,7 @@ fn every_loader_error_is_one_located_line_with_exit_2() {
     let ply = b"ply\nformat binary_little_endian 1.0\nelement vertex 4000000000\n\
         property float x\nproperty float y\nproperty float z\nelement face 1\n\
         property list uchar int vertex_indices\nend_header\n\0\0";
-    let cases: Vec<(String, (&str, &[u8]), Vec<&str>)> = vec![
+    let cases: Vec<Case> = vec![
         (
             MESH_SHAPE.replace("FILE", "bad.obj"),
             ("bad.obj", b"v 0 0 0\nv 1 0 0\nv 0 x 0\nf 1 2 3\n"),
