@@ -176,6 +176,20 @@ pub fn load_scene_with(path: &Path, options: &LoadOptions) -> Result<LoadedScene
     }
 }
 
+/// `text` with control characters (a quoted newline, say) written as escapes, so that
+/// a message stays on one line.
+pub(crate) fn escape_control(text: &str) -> String {
+    text.chars()
+        .map(|c| {
+            if c.is_control() {
+                c.escape_default().to_string()
+            } else {
+                c.to_string()
+            }
+        })
+        .collect()
+}
+
 /// A text being parsed and the name it is reported under: turns byte offsets into
 /// 1-based `line:col` spans (columns count characters, not bytes).
 #[derive(Clone, Debug)]

@@ -2,6 +2,8 @@
 //! budget, minimized by hand to what triggers the bug, each with the fix's outcome: a
 //! located one-line error (or a successful parse), never a panic.
 
+use std::path::Path;
+
 /// A one-line error located in `file`.
 fn assert_located(message: &str, file: &str) {
     assert!(
@@ -22,4 +24,20 @@ fn ies_latin1_header_line_across_byte_5() {
     // The same line with TILT= first still counts as the tilt line.
     let ok = b"IESNA:LM-63-2002\nTILT=NONE\n1 -1 1 2 1 1 2 0 0 0\n1 1 0\n0 90\n0\n10 10\n";
     assert!(candela_scene::ies::parse_ies(ok, "f.ies").is_ok());
+}
+
+/// fuzz target `mitsuba`: roxmltree's message quotes the unexpected character, here a
+/// newline, which broke the error across two lines.
+#[test]
+fn mitsuba_xml_error_quoting_a_newline_stays_on_one_line() {
+    let options = candela_scene::LoadOptions::default();
+    let text = "<scene version=\"3.0.0\">\n<shape/\n></scene>";
+    let e = candela_scene::mitsuba::parse_mitsuba(text, Path::new("f.xml"), &options)
+        .unwrap_err()
+        .to_string();
+    assert_located(&e, "f.xml:2:8: XML: ");
+    assert!(
+        e.contains("not '\\n'"),
+        "the newline is written as an escape: {e}"
+    );
 }

@@ -235,7 +235,8 @@ impl Parser {
             let pos = e.pos();
             LoadError::new(
                 Span::new(src.file.clone(), pos.row, pos.col),
-                format!("XML: {e}"),
+                // roxmltree quotes the offending character, which may be a newline.
+                format!("XML: {}", crate::escape_control(&e.to_string())),
             )
         })?;
         let root = doc.root_element();
