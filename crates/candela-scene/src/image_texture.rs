@@ -49,7 +49,11 @@ pub fn load_image(path: &Path, encoding: Encoding) -> Result<ImageDesc, String> 
 /// against the file's size before any pixel is allocated
 /// ([`crate::limits::check_image_size`]).
 pub fn decode_image(bytes: &[u8], path: &Path, encoding: Encoding) -> Result<ImageDesc, String> {
-    let fail = |e: &dyn std::fmt::Display| format!("{}: cannot read image: {e}", path.display());
+    // Decoders' messages may end in a newline (JPEG's do): keep the error on one line.
+    let fail = |e: &dyn std::fmt::Display| {
+        let e = crate::escape_control(e.to_string().trim());
+        format!("{}: cannot read image: {e}", path.display())
+    };
     match check_extension(path)? {
         None => decode_exr(bytes).map_err(|e| fail(&e)),
         Some(format) => {

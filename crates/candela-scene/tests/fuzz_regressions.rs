@@ -41,3 +41,52 @@ fn mitsuba_xml_error_quoting_a_newline_stays_on_one_line() {
         "the newline is written as an escape: {e}"
     );
 }
+
+/// An image of each format Candela reads, 5×3 pixels, encoded in memory.
+fn small_images() -> Vec<(&'static str, Vec<u8>)> {
+    let rgb = image::RgbImage::from_fn(5, 3, |x, y| image::Rgb([x as u8 * 50, y as u8 * 80, 7]));
+    let mut out = Vec::new();
+    for (name, format) in [
+        ("t.png", image::ImageFormat::Png),
+        ("t.jpg", image::ImageFormat::Jpeg),
+        ("t.tga", image::ImageFormat::Tga),
+        ("t.bmp", image::ImageFormat::Bmp),
+    ] {
+        let mut bytes = std::io::Cursor::new(Vec::new());
+        rgb.write_to(&mut bytes, format).unwrap();
+        out.push((name, bytes.into_inner()));
+    }
+    let hdr = image::DynamicImage::ImageRgb8(rgb).to_rgb32f();
+    let mut bytes = std::io::Cursor::new(Vec::new());
+    hdr.write_to(&mut bytes, image::ImageFormat::Hdr).unwrap();
+    out.push(("t.hdr", bytes.into_inner()));
+    let mut bytes = Vec::new();
+    use exr::prelude::*;
+    Image::from_channels(
+        (5, 3),
+        SpecificChannels::rgb(|p: Vec2<usize>| (p.0 as f32, p.1 as f32, 0.5f32)),
+    )
+    .write()
+    .to_buffered(std::io::Cursor::new(&mut bytes))
+    .unwrap();
+    out.push(("t.exr", bytes));
+    out
+}
+
+/// fuzz target `image`: a truncated JPEG's message ended in a newline. Every truncation
+/// of a small file of every format is now a one-line error naming the file (or, where
+/// the format tolerates a short file, a 5×3 image).
+#[test]
+fn every_truncation_of_every_image_format_is_a_one_line_error() {
+    use candela_scene::image_texture::{decode_image, Encoding};
+    for (name, bytes) in small_images() {
+        let whole = decode_image(&bytes, Path::new(name), Encoding::Srgb).unwrap();
+        assert_eq!((whole.width, whole.height), (5, 3), "{name}");
+        for len in 0..bytes.len() {
+            match decode_image(&bytes[..len], Path::new(name), Encoding::Srgb) {
+                Err(e) => assert_located(&e, &format!("{name}: cannot read image: ")),
+                Ok(img) => assert_eq!((img.width, img.height), (5, 3), "{name} at {len}"),
+            }
+        }
+    }
+}
