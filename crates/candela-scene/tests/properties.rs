@@ -114,7 +114,7 @@ fn scene() -> impl Strategy<Value = String> {
                 write!(s, "[materials.m{i}]\n{m}\n\n").unwrap();
             }
             for x in shapes.iter().chain(&lights) {
-                write!(s, "{x}\n").unwrap();
+                writeln!(s, "{x}").unwrap();
             }
             s
         })
