@@ -272,3 +272,32 @@ fn a_read_only_folder_keeps_the_previous_output_intact() {
     assert_user_error(&o, &["keep.png: cannot write:"]);
     assert_eq!(std::fs::read(&out).unwrap(), b"previous image");
 }
+
+#[test]
+fn a_resolution_past_the_pixel_cap_is_an_error_not_an_abort() {
+    let (dir, scene) = scene_with("", &[]);
+    let huge = dir.path().join("huge.toml");
+    std::fs::write(
+        &huge,
+        SCENE.replace("resolution = [24, 16]", "resolution = [100000, 100000]"),
+    )
+    .unwrap();
+    let out = dir.path().join("x.png");
+    let o = run(&["render", s(&huge), "-o", s(&out)]);
+    assert_user_error(&o, &["huge.toml:3:14:", "100000x100000", "more than"]);
+    let o = run(&["render", s(&scene), "-o", s(&out), "--res", "100000x100000"]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("more than"));
+    // A wide image under the cap is not refused.
+    let o = run(&[
+        "render",
+        s(&scene),
+        "-o",
+        s(&out),
+        "--res",
+        "8192x1",
+        "--spp",
+        "1",
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+}
