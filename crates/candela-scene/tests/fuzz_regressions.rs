@@ -90,3 +90,25 @@ fn every_truncation_of_every_image_format_is_a_one_line_error() {
         }
     }
 }
+
+/// Found by hand after the campaign (the fuzzer's 64 KiB inputs did not reach it): XML
+/// nested 200000 deep overflowed the stack in the recursive conversion of the tree.
+#[test]
+fn mitsuba_deeply_nested_xml_is_an_error_not_a_stack_overflow() {
+    let n = 200_000;
+    let text = format!(
+        "<scene version=\"3.0.0\">{}{}</scene>",
+        "<a>".repeat(n),
+        "</a>".repeat(n)
+    );
+    let options = candela_scene::LoadOptions::default();
+    let e = candela_scene::mitsuba::parse_mitsuba(&text, Path::new("deep.xml"), &options)
+        .unwrap_err()
+        .to_string();
+    assert_located(&e, "deep.xml:1:");
+    assert!(e.contains("nest deeper than"), "{e}");
+    // TOML's parser has its own recursion limit.
+    let text = format!("a = {}{}\n", "[".repeat(n), "]".repeat(n));
+    let e = candela_scene::parse_toml_scene(&text, Path::new("deep.toml")).unwrap_err();
+    assert_located(&e.to_string(), "deep.toml:1:");
+}
