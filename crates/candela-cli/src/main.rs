@@ -61,6 +61,10 @@ fn main() -> ExitCode {
             "candela: this is a bug in Candela; please report it with the scene that caused it"
         );
     }));
+    // Lets the tests see a panic take the path above: the message and exit code 101.
+    if std::env::var_os("CANDELA_TEST_INTERNAL_ERROR").is_some() {
+        panic!("CANDELA_TEST_INTERNAL_ERROR is set");
+    }
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Render(args) => render::run(args),

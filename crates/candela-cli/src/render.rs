@@ -142,7 +142,7 @@ fn parse_resolution(s: &str) -> Result<(u32, u32), String> {
         .ok_or_else(|| format!("expected WIDTHxHEIGHT, got \"{s}\""))?;
     let parse = |v: &str| v.trim().parse::<u32>().ok().filter(|&v| v > 0);
     match (parse(w), parse(h)) {
-        (Some(w), Some(h)) => Ok((w, h)),
+        (Some(w), Some(h)) => candela_core::build::check_resolution(w, h).map(|()| (w, h)),
         _ => Err(format!(
             "expected WIDTHxHEIGHT with positive integers, got \"{s}\""
         )),

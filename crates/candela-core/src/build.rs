@@ -69,14 +69,29 @@ fn check_color(span: &Span, what: &str, c: Vec3) -> Result<(), BuildError> {
     Ok(())
 }
 
+/// The most pixels an image may have: 2²⁶ (8192 × 8192), whose film takes 2.7 GB. A
+/// resolution is two numbers in a small file, so without a cap a scene of a hundred bytes
+/// could ask for terabytes.
+pub const MAX_PIXELS: u64 = 1 << 26;
+
+/// Checks a resolution: not empty, at most [`MAX_PIXELS`].
+pub fn check_resolution(width: u32, height: u32) -> Result<(), String> {
+    if width == 0 || height == 0 {
+        return Err(format!("resolution {width}x{height} is empty"));
+    }
+    if width as u64 * height as u64 > MAX_PIXELS {
+        return Err(format!(
+            "resolution {width}x{height} has more than {MAX_PIXELS} pixels (8192x8192)"
+        ));
+    }
+    Ok(())
+}
+
 /// Validates a description and builds the scene.
 pub fn build(desc: &SceneDesc) -> Result<Scene, BuildError> {
     let r = &desc.render;
-    if r.width == 0 || r.height == 0 {
-        return err(
-            &Span::code(),
-            format!("resolution {}x{} is empty", r.width, r.height),
-        );
+    if let Err(m) = check_resolution(r.width, r.height) {
+        return err(&Span::code(), m);
     }
     if r.spp == 0 {
         return err(&Span::code(), "spp must be at least 1");

@@ -6,11 +6,14 @@
 //! (`gamma = 2.2`); data textures (roughness, metallic, normal maps) are linear. Float
 //! images (EXR, HDR) are linear already and never decoded. Alpha is dropped.
 
+use std::io::Cursor;
 use std::path::Path;
 
 use candela_core::color::srgb_decode;
 use candela_core::desc::ImageDesc;
 use glam::Vec3;
+
+use crate::limits::{allocation_budget, check_image_size};
 
 /// How an integer image's values map to linear ones.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -35,23 +38,76 @@ impl Encoding {
 /// Loads an image file as linear RGB, choosing the decoder by extension. Errors name the
 /// file and the reason.
 pub fn load_image(path: &Path, encoding: Encoding) -> Result<ImageDesc, String> {
+    check_extension(path)?;
+    let bytes =
+        std::fs::read(path).map_err(|e| format!("{}: cannot read image: {e}", path.display()))?;
+    decode_image(&bytes, path, encoding)
+}
+
+/// Decodes the bytes of an image file as linear RGB; `path` names the file in errors and
+/// its extension chooses the decoder. The dimensions the header declares are checked
+/// against the file's size before any pixel is allocated
+/// ([`crate::limits::check_image_size`]).
+pub fn decode_image(bytes: &[u8], path: &Path, encoding: Encoding) -> Result<ImageDesc, String> {
+    // Decoders' messages may end in a newline (JPEG's do): keep the error on one line.
+    let fail = |e: &dyn std::fmt::Display| {
+        let e = crate::escape_control(e.to_string().trim());
+        format!("{}: cannot read image: {e}", path.display())
+    };
+    match check_extension(path)? {
+        None => decode_exr(bytes).map_err(|e| fail(&e)),
+        Some(format) => {
+            let img = decode_with_image(bytes, format).map_err(|e| fail(&e))?;
+            Ok(from_dynamic(&img, encoding))
+        }
+    }
+}
+
+/// The `image` crate's format for the file's extension, `None` for EXR, or an error for
+/// an extension Candela does not read.
+fn check_extension(path: &Path) -> Result<Option<image::ImageFormat>, String> {
     let ext = path
         .extension()
         .map(|e| e.to_string_lossy().to_ascii_lowercase())
         .unwrap_or_default();
-    let fail = |e: &dyn std::fmt::Display| format!("{}: cannot read image: {e}", path.display());
     match ext.as_str() {
-        "exr" => load_exr(path).map_err(|e| fail(&e)),
-        "png" | "jpg" | "jpeg" | "tga" | "bmp" | "hdr" => {
-            let img = image::open(path).map_err(|e| fail(&e))?;
-            Ok(from_dynamic(&img, encoding))
-        }
+        "exr" => Ok(None),
+        "png" | "jpg" | "jpeg" | "tga" | "bmp" | "hdr" => Ok(Some(
+            image::ImageFormat::from_extension(&ext).expect("a known extension"),
+        )),
         _ => Err(format!(
             "{}: unsupported image format \".{ext}\"; supported: .png, .jpg, .jpeg, .tga, \
              .bmp, .hdr, .exr",
             path.display()
         )),
     }
+}
+
+/// Opens an image as `image` decodes it, keeping its colour type (PNG, JPEG, TGA, BMP,
+/// HDR; not EXR), within the file's allocation budget.
+pub(crate) fn open_dynamic(path: &Path) -> Result<image::DynamicImage, String> {
+    let Some(format) = check_extension(path)? else {
+        return Err(format!("{}: EXR is not supported here", path.display()));
+    };
+    let bytes = std::fs::read(path).map_err(|e| e.to_string())?;
+    decode_with_image(&bytes, format)
+}
+
+/// Decodes through `image`, with its own allocation limit set to the file's budget and
+/// the declared dimensions checked first (the decoder's limit does not count Candela's
+/// conversions).
+fn decode_with_image(
+    bytes: &[u8],
+    format: image::ImageFormat,
+) -> Result<image::DynamicImage, String> {
+    let reader = || image::ImageReader::with_format(Cursor::new(bytes), format);
+    let (w, h) = reader().into_dimensions().map_err(|e| e.to_string())?;
+    check_image_size(w.into(), h.into(), bytes.len())?;
+    let mut limits = image::Limits::default();
+    limits.max_alloc = Some(allocation_budget(bytes.len()));
+    let mut reader = reader();
+    reader.limits(limits);
+    reader.decode().map_err(|e| e.to_string())
 }
 
 /// Converts a decoded image to linear RGB: float images as they are, integer ones
@@ -73,20 +129,35 @@ pub fn from_dynamic(img: &image::DynamicImage, encoding: Encoding) -> ImageDesc 
     }
 }
 
-fn load_exr(path: &Path) -> Result<ImageDesc, exr::error::Error> {
+/// Decodes the first RGB(A) layer of an EXR file at its largest resolution level. Every
+/// layer's declared size is checked against the file's budget before its pixels are
+/// allocated.
+fn decode_exr(bytes: &[u8]) -> Result<ImageDesc, String> {
     use exr::prelude::*;
-    let image = read_first_rgba_layer_from_file(
-        path,
-        |res, _| ImageDesc {
-            width: res.width() as u32,
-            height: res.height() as u32,
-            pixels: vec![Vec3::ZERO; res.width() * res.height()],
-        },
-        |img: &mut ImageDesc, pos, (r, g, b, _a): (f32, f32, f32, f32)| {
-            let w = img.width as usize;
-            img.pixels[pos.y() * w + pos.x()] = Vec3::new(r, g, b);
-        },
-    )?;
+    let meta = exr::meta::MetaData::read_from_buffered(Cursor::new(bytes), false)
+        .map_err(|e| e.to_string())?;
+    for header in meta.headers.iter() {
+        let size = header.layer_size;
+        check_image_size(size.width() as u64, size.height() as u64, bytes.len())?;
+    }
+    let image = read()
+        .no_deep_data()
+        .largest_resolution_level()
+        .rgba_channels(
+            |res, _| ImageDesc {
+                width: res.width() as u32,
+                height: res.height() as u32,
+                pixels: vec![Vec3::ZERO; res.width() * res.height()],
+            },
+            |img: &mut ImageDesc, pos, (r, g, b, _a): (f32, f32, f32, f32)| {
+                let w = img.width as usize;
+                img.pixels[pos.y() * w + pos.x()] = Vec3::new(r, g, b);
+            },
+        )
+        .first_valid_layer()
+        .all_attributes()
+        .from_buffered(Cursor::new(bytes))
+        .map_err(|e| e.to_string())?;
     Ok(image.layer_data.channel_data.pixels)
 }
 

@@ -36,6 +36,7 @@ use candela_core::desc::{MeshDesc, SceneDesc, Span};
 pub mod environment;
 pub mod gltf;
 pub mod image_texture;
+pub mod limits;
 pub mod obj;
 pub mod ply;
 mod toml_camera;
@@ -176,6 +177,20 @@ pub fn load_scene_with(path: &Path, options: &LoadOptions) -> Result<LoadedScene
             format!("unsupported scene format \".{other}\"; supported: .toml, .xml, .gltf, .glb"),
         )),
     }
+}
+
+/// `text` with control characters (a quoted newline, say) written as escapes, so that
+/// a message stays on one line.
+pub(crate) fn escape_control(text: &str) -> String {
+    text.chars()
+        .map(|c| {
+            if c.is_control() {
+                c.escape_default().to_string()
+            } else {
+                c.to_string()
+            }
+        })
+        .collect()
 }
 
 /// A text being parsed and the name it is reported under: turns byte offsets into

@@ -33,6 +33,7 @@ pub fn parse_ply(bytes: &[u8], path: &Path) -> Result<MeshDesc, MeshError> {
         .map_err(|e| err(e.line(), one_line(&e)))?;
     let body = bytes.len() - reader.get_ref().position() as usize;
     check_sizes(&header, body).map_err(|m| err(None, m))?;
+    check_memory(&header, bytes.len()).map_err(|m| err(None, m))?;
 
     let vertex = header
         .elements
@@ -184,6 +185,35 @@ fn check_sizes(header: &Header, body: usize) -> Result<(), String> {
             "PLY header declares {} (at least {need} bytes) but only {body} bytes follow it; \
              the file is truncated or corrupt",
             counts.join(", ")
+        ));
+    }
+    Ok(())
+}
+
+/// Heap bytes one parsed property takes: `ply-rs` keeps each element's properties in a
+/// map keyed by name, 130–150 bytes a property as measured by `tests/limits.rs`, plus
+/// the mesh's own copy.
+const PARSED_BYTES_PER_PROPERTY: u128 = 160;
+
+/// Rejects a header whose elements would take more memory once parsed than the file's
+/// [`allocation_budget`](crate::limits::allocation_budget). Binary properties take at
+/// least a byte and ascii ones two, so only ascii files with most numbers a single digit
+/// (up to ~80× their size in memory) and of tens of megabytes can meet this.
+fn check_memory(header: &Header, file_len: usize) -> Result<(), String> {
+    let properties: u128 = header
+        .elements
+        .values()
+        .map(|e| e.count as u128 * e.properties.len() as u128)
+        .sum();
+    let need = properties * PARSED_BYTES_PER_PROPERTY;
+    let budget = crate::limits::allocation_budget(file_len);
+    if need > budget as u128 {
+        return Err(format!(
+            "PLY header declares {properties} properties, which would take about {} MiB \
+             to parse; a file of {file_len} bytes may use at most {} MiB (64 × its size + \
+             256 MiB)",
+            need >> 20,
+            budget >> 20
         ));
     }
     Ok(())

@@ -210,7 +210,7 @@ fn load_aperture_image(
     path: &Path,
     name: &str,
 ) -> Result<ApertureDesc, LoadError> {
-    let img = image::open(path)
+    let img = crate::image_texture::open_dynamic(path)
         .map_err(|e| src.error(at, format!("cannot read aperture image `{name}`: {e}")))?;
     let linear = matches!(
         img.color(),

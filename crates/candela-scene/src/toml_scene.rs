@@ -170,7 +170,7 @@ pub(crate) fn item_type(
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
 struct RenderSection {
-    resolution: Option<[u32; 2]>,
+    resolution: Option<Spanned<[u32; 2]>>,
     spp: Option<u32>,
     max_depth: Option<u32>,
     seed: Option<u64>,
@@ -183,7 +183,9 @@ struct RenderSection {
 fn parse_render(src: &Source, value: Item) -> Result<RenderSettings, LoadError> {
     let r: RenderSection = deserialize(src, value)?;
     let mut out = RenderSettings::default();
-    if let Some([w, h]) = r.resolution {
+    if let Some(res) = r.resolution {
+        let [w, h] = *res.get_ref();
+        candela_core::build::check_resolution(w, h).map_err(|m| src.error(res.span().start, m))?;
         (out.width, out.height) = (w, h);
     }
     out.spp = r.spp.unwrap_or(out.spp);

@@ -40,7 +40,11 @@ pub fn parse_ies(bytes: &[u8], file: &str) -> Result<IesFile, LoadError> {
     let mut tilt_line = None;
     for (i, raw) in lines.iter().enumerate().skip(header_start) {
         let line = raw.trim();
-        if line.len() >= 5 && line[..5].eq_ignore_ascii_case("TILT=") {
+        // `get`: a Latin-1 header line may have a multi-byte character before byte 5.
+        if line
+            .get(..5)
+            .is_some_and(|t| t.eq_ignore_ascii_case("TILT="))
+        {
             tilt_line = Some((i, line[5..].trim().to_string()));
             break;
         }

@@ -27,6 +27,22 @@ pub use sensor::candela_max_depth;
 /// Loads a Mitsuba 3 XML scene.
 pub fn load_mitsuba(path: &Path, options: &LoadOptions) -> Result<LoadedScene, LoadError> {
     let root = parse::parse_file(path, &options.defines)?;
+    map_scene(root, path, options)
+}
+
+/// Parses a Mitsuba 3 XML scene from its text; `path` names it in errors, and files it
+/// refers to (meshes, textures, includes) are looked up beside it.
+pub fn parse_mitsuba(
+    text: &str,
+    path: &Path,
+    options: &LoadOptions,
+) -> Result<LoadedScene, LoadError> {
+    let root = parse::parse_str(text, path, &options.defines)?;
+    map_scene(root, path, options)
+}
+
+/// Maps a parsed `<scene>` to Candela's description.
+fn map_scene(root: Node, path: &Path, options: &LoadOptions) -> Result<LoadedScene, LoadError> {
     let mut ctx = Ctx {
         lenient: options.lenient,
         base: path.parent().unwrap_or(Path::new("")).to_path_buf(),

@@ -14,6 +14,11 @@ use crate::{LoadError, Source};
 /// How deep `<include>`s may nest before we call it a cycle.
 const MAX_INCLUDE_DEPTH: usize = 16;
 
+/// How deep elements may nest. Mitsuba scenes nest a handful of levels (a BSDF in a
+/// BSDF in a shape); the tree is converted recursively, so without a cap a file of a
+/// few hundred kilobytes of `<a><a><a>…` would overflow the stack.
+const MAX_NESTING: usize = 128;
+
 /// One XML element after substitution: a plugin (`shape`, `bsdf`, …), a property
 /// (`float`, `rgb`, …), a `transform` step, or a `ref`.
 #[derive(Debug)]
@@ -204,13 +209,23 @@ pub(crate) fn is_property(tag: &str) -> bool {
 /// Parses a scene file (and what it includes) into its `<scene>` node. `defines` are the
 /// `-D name=value` parameters, which take precedence over `<default>`s.
 pub(crate) fn parse_file(path: &Path, defines: &[(String, String)]) -> Result<Node, LoadError> {
-    let mut p = Parser {
-        params: defines.iter().cloned().collect(),
-    };
     let span = Span::new(path.display().to_string(), 1, 1);
     let text = std::fs::read_to_string(path)
         .map_err(|e| LoadError::new(span, format!("cannot read scene file: {e}")))?;
-    p.parse_text(path, &text, 0)
+    parse_str(&text, path, defines)
+}
+
+/// Parses a scene's text into its `<scene>` node; `path` names it in errors and is where
+/// `<include>`d files are looked up.
+pub(crate) fn parse_str(
+    text: &str,
+    path: &Path,
+    defines: &[(String, String)],
+) -> Result<Node, LoadError> {
+    let mut p = Parser {
+        params: defines.iter().cloned().collect(),
+    };
+    p.parse_text(path, text, 0)
 }
 
 struct Parser {
@@ -225,7 +240,8 @@ impl Parser {
             let pos = e.pos();
             LoadError::new(
                 Span::new(src.file.clone(), pos.row, pos.col),
-                format!("XML: {e}"),
+                // roxmltree quotes the offending character, which may be a newline.
+                format!("XML: {}", crate::escape_control(&e.to_string())),
             )
         })?;
         let root = doc.root_element();
@@ -258,7 +274,7 @@ impl Parser {
                 .entry(name.to_string())
                 .or_insert_with(|| value.to_string());
         }
-        let mut scene = self.convert(&src, root)?;
+        let mut scene = self.convert(&src, root, 0)?;
         let mut children = Vec::new();
         for c in std::mem::take(&mut scene.children) {
             match c.tag.as_str() {
@@ -283,8 +299,14 @@ impl Parser {
         self.parse_text(&file, &text, depth + 1)
     }
 
-    fn convert(&self, src: &Source, e: roxmltree::Node) -> Result<Node, LoadError> {
+    fn convert(&self, src: &Source, e: roxmltree::Node, depth: usize) -> Result<Node, LoadError> {
         let at = e.range().start;
+        if depth >= MAX_NESTING {
+            return Err(src.error(
+                at,
+                format!("elements nest deeper than {MAX_NESTING} levels"),
+            ));
+        }
         let mut attrs = Vec::new();
         for a in e.attributes() {
             let value = self
@@ -295,7 +317,7 @@ impl Parser {
         let children = e
             .children()
             .filter(|c| c.is_element())
-            .map(|c| self.convert(src, c))
+            .map(|c| self.convert(src, c, depth + 1))
             .collect::<Result<_, _>>()?;
         Ok(Node {
             tag: e.tag_name().name().to_string(),
