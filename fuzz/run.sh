@@ -29,6 +29,7 @@ seeds_ply() { files '*.ply'; }
 seeds_ies() { files '*.ies'; }
 seeds_mitsuba() { files '*.xml'; }
 seeds_exr() { files '*.exr'; }
+seeds_gltf() { files '*.gltf' '*.glb'; }
 seeds_image() { :; }
 
 corpus=$here/corpus/$target

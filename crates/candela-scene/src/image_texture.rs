@@ -93,6 +93,13 @@ pub(crate) fn open_dynamic(path: &Path) -> Result<image::DynamicImage, String> {
     decode_with_image(&bytes, format)
 }
 
+/// Decodes an image whose format is known only from its bytes (a glTF's embedded or
+/// `data:` images), within the same allocation budget as a file.
+pub(crate) fn decode_guessed(bytes: &[u8]) -> Result<image::DynamicImage, String> {
+    let format = image::guess_format(bytes).map_err(|e| e.to_string())?;
+    decode_with_image(bytes, format)
+}
+
 /// Decodes through `image`, with its own allocation limit set to the file's budget and
 /// the declared dimensions checked first (the decoder's limit does not count Candela's
 /// conversions).

@@ -8,7 +8,7 @@ use candela_core::desc::ImageDesc;
 use glam::{Vec2, Vec3};
 
 use super::Ctx;
-use crate::image_texture::{from_dynamic, Encoding};
+use crate::image_texture::{decode_guessed, from_dynamic, Encoding};
 use crate::LoadError;
 
 /// How an image's pixels are decoded for one use.
@@ -31,8 +31,10 @@ pub(crate) fn decode(
     let source = texture.source();
     let where_ = format!("{path}: images[{}]", source.index());
     let bytes = image_bytes(ctx, &source).map_err(|e| ctx.error(&where_, e))?;
-    let dynamic = image::load_from_memory(&bytes)
-        .map_err(|e| ctx.error(&where_, format!("cannot decode image: {e}")))?;
+    let dynamic = decode_guessed(&bytes).map_err(|e| {
+        let e = crate::escape_control(e.trim());
+        ctx.error(&where_, format!("cannot decode image: {e}"))
+    })?;
     let img = match use_ {
         Use::Color => from_dynamic(&dynamic, Encoding::Srgb),
         Use::Data => from_dynamic(&dynamic, Encoding::Gamma(1.0)),
