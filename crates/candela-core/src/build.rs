@@ -628,6 +628,16 @@ fn validate_mesh(m: &MeshDesc, span: &Span) -> Result<(), BuildError> {
             ),
         );
     }
+    if !m.colors.is_empty() && m.colors.len() != m.positions.len() {
+        return err(
+            span,
+            format!(
+                "mesh has {} colours for {} positions",
+                m.colors.len(),
+                m.positions.len()
+            ),
+        );
+    }
     if let Some(i) = m
         .indices
         .iter()
@@ -642,7 +652,11 @@ fn validate_mesh(m: &MeshDesc, span: &Span) -> Result<(), BuildError> {
             ),
         );
     }
-    if m.positions.iter().chain(&m.normals).any(|p| !p.is_finite())
+    if m.positions
+        .iter()
+        .chain(&m.normals)
+        .chain(&m.colors)
+        .any(|p| !p.is_finite())
         || m.uvs.iter().any(|uv| !uv.is_finite())
     {
         return err(span, "mesh has a non-finite vertex attribute");
@@ -664,6 +678,7 @@ fn to_world(local: MeshDesc, m: Mat4, material: MaterialId) -> Mesh {
             .map(|&n| (normal_matrix * n).normalize_or_zero())
             .collect(),
         uvs: local.uvs,
+        colors: local.colors,
         indices: local.indices,
         material,
         lights: Vec::new(),
@@ -689,6 +704,7 @@ pub fn rectangle() -> MeshDesc {
             Vec2::new(0.0, 1.0),
         ],
         indices: vec![[0, 1, 2], [0, 2, 3]],
+        colors: Vec::new(),
     }
 }
 
@@ -711,6 +727,7 @@ pub fn disk(segments: u32) -> MeshDesc {
         positions,
         uvs,
         indices,
+        colors: Vec::new(),
     }
 }
 

@@ -306,13 +306,17 @@ pub enum GeometryDesc {
     Cube,
 }
 
-/// An indexed triangle mesh. `normals` and `uvs` are either empty or one per position.
+/// An indexed triangle mesh. `normals`, `uvs` and `colors` are either empty or one per
+/// position.
 #[derive(Clone, Debug, Default)]
 pub struct MeshDesc {
     pub positions: Vec<Vec3>,
     pub normals: Vec<Vec3>,
     pub uvs: Vec<Vec2>,
     pub indices: Vec<[u32; 3]>,
+    /// Linear RGB vertex colours (glTF COLOR_0), multiplying the material's base colour
+    /// (diffuse and plastic albedo, metal_rough base colour) where given.
+    pub colors: Vec<Vec3>,
 }
 
 /// A light that is not a shape.

@@ -4,6 +4,7 @@ use glam::{Vec2, Vec3};
 
 use crate::bsdf::{Bsdf, Diffuse, Lobe, MetalRough, Plastic};
 use crate::math::Frame;
+use crate::scene::SurfaceInteraction;
 pub use crate::texture::Texture;
 
 /// Index of a material in [`crate::Scene::materials`].
@@ -47,27 +48,38 @@ impl Material {
 
     /// The BSDF with `dpdu` (the surface's ∂p/∂u) giving the tangent of the shading frame.
     pub fn bsdf_with_tangent(&self, ns: Vec3, ng: Vec3, uv: Vec2, dpdu: Vec3) -> Bsdf {
+        self.bsdf_tinted(ns, ng, uv, dpdu, Vec3::ONE)
+    }
+
+    /// The BSDF at a surface interaction: its frame, uvs and vertex colour.
+    pub fn bsdf_at(&self, si: &SurfaceInteraction) -> Bsdf {
+        self.bsdf_tinted(si.ns, si.ng, si.uv, si.dpdu, si.color)
+    }
+
+    /// The BSDF with the base colour (diffuse and plastic albedo, metal_rough base colour)
+    /// multiplied by `color`, a vertex colour; other lobes ignore it.
+    pub fn bsdf_tinted(&self, ns: Vec3, ng: Vec3, uv: Vec2, dpdu: Vec3, color: Vec3) -> Bsdf {
         match self {
             Material::NormalMap { map, inner } => {
                 let n = normal_mapped(ns, ng, dpdu, map.eval(uv));
-                inner.bsdf_with_tangent(n, ng, uv, dpdu)
+                inner.bsdf_tinted(n, ng, uv, dpdu, color)
             }
             Material::OneSided(inner) => Bsdf {
                 one_sided: true,
-                ..inner.bsdf_with_tangent(ns, ng, uv, dpdu)
+                ..inner.bsdf_tinted(ns, ng, uv, dpdu, color)
             },
-            _ => Bsdf::with_tangent(ns, ng, dpdu, self.lobe(uv)),
+            _ => Bsdf::with_tangent(ns, ng, dpdu, self.lobe(uv, color)),
         }
     }
 
-    fn lobe(&self, uv: Vec2) -> Lobe {
+    fn lobe(&self, uv: Vec2, color: Vec3) -> Lobe {
         match self {
             Material::Diffuse { albedo } => Lobe::Diffuse(Diffuse {
-                albedo: albedo.eval(uv),
+                albedo: albedo.eval(uv) * color,
             }),
             Material::Fixed(lobe) => *lobe,
             Material::Plastic { albedo, coat } => Lobe::Plastic(Plastic {
-                albedo: albedo.eval(uv).min(Vec3::ONE),
+                albedo: (albedo.eval(uv) * color).min(Vec3::ONE),
                 ..*coat
             }),
             Material::MetalRough {
@@ -75,11 +87,11 @@ impl Material {
                 metallic,
                 roughness,
             } => Lobe::MetalRough(MetalRough::new(
-                base_color.eval(uv),
+                base_color.eval(uv) * color,
                 metallic.eval_scalar(uv),
                 roughness.eval_scalar(uv),
             )),
-            Material::NormalMap { inner, .. } | Material::OneSided(inner) => inner.lobe(uv),
+            Material::NormalMap { inner, .. } | Material::OneSided(inner) => inner.lobe(uv, color),
         }
     }
 }

@@ -21,6 +21,8 @@ pub struct Mesh {
     pub normals: Vec<Vec3>,
     /// Empty, or one per position.
     pub uvs: Vec<Vec2>,
+    /// Empty, or one linear RGB vertex colour per position (see [`crate::desc::MeshDesc`]).
+    pub colors: Vec<Vec3>,
     pub indices: Vec<[u32; 3]>,
     pub material: MaterialId,
     /// Light of each triangle, if the mesh emits (same length as `indices`).
@@ -92,6 +94,9 @@ pub struct SurfaceInteraction {
     /// ∂p/∂u, the direction of increasing u (zero where the uvs are degenerate): the
     /// tangent of normal maps and anisotropic roughness.
     pub dpdu: Vec3,
+    /// The interpolated vertex colour multiplying the base colour; one where the mesh has
+    /// none (and on spheres).
+    pub color: Vec3,
     pub material: MaterialId,
     pub light: Option<LightId>,
 }
@@ -251,6 +256,11 @@ impl Scene {
                 } else {
                     triangle_dpdu([p0, p1, p2], [m.uvs[a], m.uvs[b], m.uvs[c]])
                 };
+                let color = if m.colors.is_empty() {
+                    Vec3::ONE
+                } else {
+                    m.colors[a] * b0 + m.colors[b] * bary.x + m.colors[c] * bary.y
+                };
                 SurfaceInteraction {
                     p,
                     t,
@@ -258,6 +268,7 @@ impl Scene {
                     ns,
                     uv,
                     dpdu,
+                    color,
                     material: m.material,
                     light,
                 }
@@ -281,6 +292,7 @@ impl Scene {
                     uv,
                     // u grows with φ = atan2(z, x): along (−z, 0, x) of the normal.
                     dpdu: Vec3::new(-n_out.z, 0.0, n_out.x),
+                    color: Vec3::ONE,
                     material: s.material,
                     light: s.light,
                 }

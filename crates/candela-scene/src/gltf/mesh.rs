@@ -6,6 +6,8 @@
 //!   skipped with a warning. Without indices the vertices are taken in order.
 //! - Normals: read where given; where missing they are left out, and the renderer shades
 //!   with the triangle's geometric normal — the flat normals glTF prescribes.
+//! - Vertex colours: COLOR_0's RGB (float or normalized u8/u16, linear) multiplies the
+//!   base colour; its alpha is not read (a warning says so where it is below 1).
 //! - Texture coordinates: the set (TEXCOORD_0 or _1) that the material's textures name,
 //!   with v flipped (glTF's v runs down the image, Candela's up).
 //! - Tangents: the renderer derives the normal-map frame from ∂p/∂u of the uvs; TANGENT
@@ -53,9 +55,6 @@ pub(crate) fn place_mesh(
                         "{path}: TANGENT is not read; normal maps use the tangent ∂p/∂u \
                          of the texture coordinates"
                     ));
-                }
-                if prim.get(&gltf::Semantic::Colors(0)).is_some() {
-                    ctx.warn(format!("{path}: vertex colors (COLOR_0) are ignored"));
                 }
                 if prim.morph_targets().next().is_some() {
                     ctx.warn(format!("{path}: morph targets are ignored"));
@@ -132,7 +131,26 @@ fn read_primitive(
             None => return Err(unreadable(ctx, path, &format!("TEXCOORD_{tex_coord}"), &a)),
         },
     };
-    for (what, len) in [("NORMAL", normals.len()), ("TEXCOORD", uvs.len())] {
+    // COLOR_0 (RGB or RGBA, float or normalized u8/u16) is linear; the crate decodes it.
+    let mut colors: Vec<Vec3> = Vec::new();
+    let mut translucent = false;
+    if let Some(a) = prim.get(&gltf::Semantic::Colors(0)) {
+        let Some(it) = reader.read_colors(0) else {
+            return Err(unreadable(ctx, path, "COLOR_0", &a));
+        };
+        colors = it
+            .into_rgba_f32()
+            .map(|[r, g, b, alpha]| {
+                translucent |= alpha < 1.0;
+                Vec3::new(r, g, b)
+            })
+            .collect();
+    }
+    for (what, len) in [
+        ("NORMAL", normals.len()),
+        ("TEXCOORD", uvs.len()),
+        ("COLOR_0", colors.len()),
+    ] {
         if len != 0 && len != n {
             return Err(ctx.error(path, format!("{what} has {len} elements for {n} positions")));
         }
@@ -147,12 +165,21 @@ fn read_primitive(
     if let Some(&i) = order.iter().find(|&&i| i as usize >= n) {
         return Err(ctx.error(path, format!("index {i} is out of range ({n} vertices)")));
     }
+    if translucent {
+        ctx.warn(format!(
+            "{path}: the alpha of COLOR_0 is ignored (only its RGB multiplies the base colour)"
+        ));
+    }
     let indices = triangulate(mode, &order);
     if indices.is_empty() {
         ctx.warn(format!("{path}: has no triangles and is skipped"));
         return Ok(None);
     }
-    if positions.iter().chain(&normals).any(|p| !p.is_finite())
+    if positions
+        .iter()
+        .chain(&normals)
+        .chain(&colors)
+        .any(|p| !p.is_finite())
         || uvs.iter().any(|uv| !uv.is_finite())
     {
         return Err(ctx.error(path, "has a non-finite vertex attribute"));
@@ -162,6 +189,7 @@ fn read_primitive(
         normals,
         uvs,
         indices,
+        colors,
     }))
 }
 
