@@ -638,6 +638,16 @@ fn validate_mesh(m: &MeshDesc, span: &Span) -> Result<(), BuildError> {
             ),
         );
     }
+    if !m.tangents.is_empty() && m.tangents.len() != m.positions.len() {
+        return err(
+            span,
+            format!(
+                "mesh has {} tangents for {} positions",
+                m.tangents.len(),
+                m.positions.len()
+            ),
+        );
+    }
     if let Some(i) = m
         .indices
         .iter()
@@ -658,6 +668,7 @@ fn validate_mesh(m: &MeshDesc, span: &Span) -> Result<(), BuildError> {
         .chain(&m.colors)
         .any(|p| !p.is_finite())
         || m.uvs.iter().any(|uv| !uv.is_finite())
+        || m.tangents.iter().any(|t| !t.is_finite())
     {
         return err(span, "mesh has a non-finite vertex attribute");
     }
@@ -665,7 +676,8 @@ fn validate_mesh(m: &MeshDesc, span: &Span) -> Result<(), BuildError> {
 }
 
 fn to_world(local: MeshDesc, m: Mat4, material: MaterialId) -> Mesh {
-    let normal_matrix = Mat3::from_mat4(m).inverse().transpose();
+    let linear = Mat3::from_mat4(m);
+    let normal_matrix = linear.inverse().transpose();
     Mesh {
         positions: local
             .positions
@@ -679,6 +691,20 @@ fn to_world(local: MeshDesc, m: Mat4, material: MaterialId) -> Mesh {
             .collect(),
         uvs: local.uvs,
         colors: local.colors,
+        // Tangents are directions: transformed by the linear part. A mirroring transform
+        // reverses n × t against the transformed bitangent, so it flips the handedness.
+        tangents: local
+            .tangents
+            .iter()
+            .map(|t| {
+                let w = if linear.determinant() < 0.0 {
+                    -t.w
+                } else {
+                    t.w
+                };
+                (linear * t.truncate()).normalize_or_zero().extend(w)
+            })
+            .collect(),
         indices: local.indices,
         material,
         lights: Vec::new(),
@@ -705,6 +731,7 @@ pub fn rectangle() -> MeshDesc {
         ],
         indices: vec![[0, 1, 2], [0, 2, 3]],
         colors: Vec::new(),
+        tangents: Vec::new(),
     }
 }
 
@@ -728,6 +755,7 @@ pub fn disk(segments: u32) -> MeshDesc {
         uvs,
         indices,
         colors: Vec::new(),
+        tangents: Vec::new(),
     }
 }
 

@@ -9,7 +9,7 @@
 use std::fmt;
 use std::sync::Arc;
 
-use glam::{Affine2, Mat3, Mat4, Vec2, Vec3};
+use glam::{Affine2, Mat3, Mat4, Vec2, Vec3, Vec4};
 
 /// Where an item of a description came from: `file:line:col` (1-based). Items made in code
 /// have an empty file name and line 0.
@@ -317,6 +317,9 @@ pub struct MeshDesc {
     /// Linear RGB vertex colours (glTF COLOR_0), multiplying the material's base colour
     /// (diffuse and plastic albedo, metal_rough base colour) where given.
     pub colors: Vec<Vec3>,
+    /// Tangents (glTF TANGENT): xyz along +u, w = ±1 the handedness, so the bitangent of
+    /// a normal map is w·(n × t). Where empty, normal maps use ∂p/∂u of the uvs.
+    pub tangents: Vec<Vec4>,
 }
 
 /// A light that is not a shape.

@@ -329,6 +329,7 @@ fn inline_mesh(
         }),
         indices: indices.into_inner(),
         colors: Vec::new(),
+        tangents: Vec::new(),
     })
 }
 

@@ -683,3 +683,78 @@ fn vertex_colors_multiply_the_albedo_of_a_lit_diffuse_quad() {
     }
     eprintln!("vertex colours: worst column deviation {worst} (plane units)");
 }
+
+/// The normal-mapped shading normals at world (−0.5, 0.2) and (0.5, 0.2) of a quad in z = 0
+/// made of two halves: x ∈ [0, 1] with u = x, and x ∈ [−1, 0] with u = −x (mirrored uvs),
+/// v up along +y on both, under a normal map of one texel `c`. `tangents` adds TANGENT
+/// ((1,0,0,1) on the right, (−1,0,0,−1) on the mirrored left); `mirror` places the mesh
+/// with scale (−1, 1, 1).
+fn mapped_normals(c: u8, tangents: bool, mirror: bool) -> [Vec3; 2] {
+    let mut g = Glb::new();
+    let tex = g.texture(&png(1, 1, |_, _| [c, c, c, 255]), None);
+    let m = g.material(json!({"normalTexture": {"index": tex}}));
+    #[rustfmt::skip]
+    let pos = g.floats(&[
+        0., -1., 0., 1., -1., 0., 1., 1., 0., 0., 1., 0.,
+        0., -1., 0., -1., -1., 0., -1., 1., 0., 0., 1., 0.,
+    ], 3, "VEC3");
+    let nrm = g.floats(&[0., 0., 1.].repeat(8), 3, "VEC3");
+    // glTF v runs down: v = 0 at y = +1.
+    #[rustfmt::skip]
+    let uv = g.floats(&[0., 1., 1., 1., 1., 0., 0., 0., 0., 1., 1., 1., 1., 0., 0., 0.], 2, "VEC2");
+    let idx = g.indices(&[0, 1, 2, 0, 2, 3, 4, 6, 5, 4, 7, 6]);
+    let mut attributes = json!({"POSITION": pos, "NORMAL": nrm, "TEXCOORD_0": uv});
+    if tangents {
+        let mut t = [1., 0., 0., 1.].repeat(4);
+        t.extend([-1., 0., 0., -1.].repeat(4));
+        attributes["TANGENT"] = json!(g.floats(&t, 4, "VEC4"));
+    }
+    let mesh = g.mesh(vec![
+        json!({"attributes": attributes, "indices": idx, "material": m}),
+    ]);
+    let scale = if mirror { -1.0 } else { 1.0 };
+    g.node(json!({"mesh": mesh, "scale": [scale, 1.0, 1.0]}), true);
+    let loaded = parse(&g).unwrap();
+    assert!(
+        loaded.warnings.iter().all(|w| !w.contains("TANGENT")),
+        "{:?}",
+        loaded.warnings
+    );
+    let scene = candela_core::build::build(&loaded.desc).unwrap();
+    [-0.5f32, 0.5].map(|x| {
+        let ray = candela_core::geometry::Ray::new(Vec3::new(x, 0.2, 3.0), -Vec3::Z);
+        let si = scene.intersect(&ray, f32::INFINITY).expect("hits the quad");
+        scene.materials[si.material.0 as usize].bsdf_at(&si).frame.n
+    })
+}
+
+#[test]
+fn normal_maps_shade_mirrored_uv_halves_with_the_right_bitangent() {
+    // The texel c = 217 decodes to m = 2c/255 − 1 = 0.702 on all three axes: tilted
+    // towards +u and +v. +v is +y on both halves; +u is +x on the right and −x on the
+    // mirrored left. So the right half must shade with normalize(m, m, m) and the left
+    // with normalize(−m, m, m) — whether the frame comes from TANGENT or from the uvs,
+    // and under a mirroring node transform (which maps each half onto the other's place).
+    // A bitangent n × t without the sign gives (−m, −m, m) on the mirrored half. The
+    // tolerance 10⁻⁴ is f32 rounding of the frame and the 8-bit texel is exact.
+    let m = 2.0 * 217.0 / 255.0 - 1.0;
+    let want = [
+        Vec3::new(-m, m, m).normalize(),
+        Vec3::new(m, m, m).normalize(),
+    ];
+    for tangents in [false, true] {
+        for mirror in [false, true] {
+            let got = mapped_normals(217, tangents, mirror);
+            eprintln!(
+                "tangents {tangents}, mirror {mirror}: left {}, right {}",
+                got[0], got[1]
+            );
+            for (g, w) in got.iter().zip(want) {
+                assert!(
+                    (*g - w).length() < 1e-4,
+                    "tangents {tangents}, mirror {mirror}: normal {g}, expected {w}"
+                );
+            }
+        }
+    }
+}
