@@ -503,16 +503,33 @@ fn build_material(bsdf: &BsdfDesc, span: &Span) -> Result<Material, BuildError> 
             alpha_u,
             alpha_v,
             thin,
+            tint,
         } => {
             check_eta(span, *eta)?;
             let distrib = check_alpha(span, *alpha_u, *alpha_v)?;
+            let clear = matches!(tint, TextureDesc::Constant(c) if *c == Vec3::ONE);
             if *thin {
                 if !distrib.effectively_smooth() {
                     return err(span, "a thin dielectric must be smooth (roughness 0)");
                 }
+                if !clear {
+                    return err(span, "a thin dielectric takes no tint");
+                }
                 Material::Fixed(Lobe::ThinDielectric(ThinDielectric { eta: *eta }))
             } else {
-                Material::Fixed(Lobe::Dielectric(Dielectric { eta: *eta, distrib }))
+                let lobe = Dielectric {
+                    eta: *eta,
+                    distrib,
+                    tint: Vec3::ONE,
+                };
+                if clear {
+                    Material::Fixed(Lobe::Dielectric(lobe))
+                } else {
+                    Material::Dielectric {
+                        tint: build_texture(tint, span, "tint")?,
+                        lobe,
+                    }
+                }
             }
         }
         BsdfDesc::Plastic { albedo, eta } => {

@@ -174,6 +174,9 @@ pub enum BsdfDesc {
         alpha_u: f32,
         alpha_v: f32,
         thin: bool,
+        /// Multiplies transmission only (glTF's base colour under KHR_materials_transmission);
+        /// constant one for clear glass. Not for thin sheets.
+        tint: TextureDesc,
     },
     /// A diffuse base under a smooth dielectric coat of index `eta`.
     Plastic { albedo: TextureDesc, eta: f32 },

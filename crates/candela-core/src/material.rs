@@ -2,7 +2,7 @@
 
 use glam::{Vec2, Vec3};
 
-use crate::bsdf::{Bsdf, Diffuse, Lobe, MetalRough, Plastic};
+use crate::bsdf::{Bsdf, Dielectric, Diffuse, Lobe, MetalRough, Plastic};
 use crate::math::Frame;
 use crate::scene::SurfaceInteraction;
 pub use crate::texture::Texture;
@@ -28,6 +28,12 @@ pub enum Material {
         base_color: Texture,
         metallic: Texture,
         roughness: Texture,
+    },
+    /// A rough or smooth dielectric whose transmission is tinted by a texture (times the
+    /// vertex colour); `lobe` is a template whose tint is replaced.
+    Dielectric {
+        tint: Texture,
+        lobe: Dielectric,
     },
     /// Bends the shading normal by a tangent-space normal map before the inner material.
     NormalMap {
@@ -86,6 +92,10 @@ impl Material {
                 albedo: albedo.eval(uv) * color,
             }),
             Material::Fixed(lobe) => *lobe,
+            Material::Dielectric { tint, lobe } => Lobe::Dielectric(Dielectric {
+                tint: tint.eval(uv) * color,
+                ..*lobe
+            }),
             Material::Plastic { albedo, coat } => Lobe::Plastic(Plastic {
                 albedo: (albedo.eval(uv) * color).min(Vec3::ONE),
                 ..*coat

@@ -64,7 +64,7 @@ fn feature_file() -> Glb {
     }));
     let m1 = g.material(json!({
         "name": "glass",
-        "pbrMetallicRoughness": {"roughnessFactor": 0.2},
+        "pbrMetallicRoughness": {"roughnessFactor": 0.2, "baseColorFactor": [0.9, 0.8, 0.7, 0.5]},
         "alphaMode": "BLEND",
         "extensions": {"KHR_materials_transmission": {"transmissionFactor": 1.0},
                        "KHR_materials_ior": {"ior": 1.33}}
@@ -258,11 +258,14 @@ fn every_feature_round_trips_into_the_expected_description() {
         alpha_u,
         alpha_v,
         thin,
+        tint: TextureDesc::Constant(tint),
     } = **inner
     else {
         panic!()
     };
     assert_eq!((eta, thin), (1.33, false));
+    // Transmission is tinted by the base colour.
+    assert_eq!(tint, Vec3::new(0.9, 0.8, 0.7));
     assert!((alpha_u - 0.04).abs() < 1e-6 && alpha_u == alpha_v);
     // The fan has no material: glTF's default (white, metallic 1, roughness 1).
     let m2 = material(d, &d.shapes[3].material);
