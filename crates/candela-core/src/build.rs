@@ -522,16 +522,33 @@ fn build_material(bsdf: &BsdfDesc, span: &Span) -> Result<Material, BuildError> 
             alpha_u,
             alpha_v,
             thin,
+            tint,
         } => {
             check_eta(span, *eta)?;
             let distrib = check_alpha(span, *alpha_u, *alpha_v)?;
+            let clear = matches!(tint, TextureDesc::Constant(c) if *c == Vec3::ONE);
             if *thin {
                 if !distrib.effectively_smooth() {
                     return err(span, "a thin dielectric must be smooth (roughness 0)");
                 }
+                if !clear {
+                    return err(span, "a thin dielectric takes no tint");
+                }
                 Material::Fixed(Lobe::ThinDielectric(ThinDielectric { eta: *eta }))
             } else {
-                Material::Fixed(Lobe::Dielectric(Dielectric { eta: *eta, distrib }))
+                let lobe = Dielectric {
+                    eta: *eta,
+                    distrib,
+                    tint: Vec3::ONE,
+                };
+                if clear {
+                    Material::Fixed(Lobe::Dielectric(lobe))
+                } else {
+                    Material::Dielectric {
+                        tint: build_texture(tint, span, "tint")?,
+                        lobe,
+                    }
+                }
             }
         }
         BsdfDesc::Plastic { albedo, eta } => {
@@ -647,6 +664,26 @@ fn validate_mesh(m: &MeshDesc, span: &Span) -> Result<(), BuildError> {
             ),
         );
     }
+    if !m.colors.is_empty() && m.colors.len() != m.positions.len() {
+        return err(
+            span,
+            format!(
+                "mesh has {} colours for {} positions",
+                m.colors.len(),
+                m.positions.len()
+            ),
+        );
+    }
+    if !m.tangents.is_empty() && m.tangents.len() != m.positions.len() {
+        return err(
+            span,
+            format!(
+                "mesh has {} tangents for {} positions",
+                m.tangents.len(),
+                m.positions.len()
+            ),
+        );
+    }
     if let Some(i) = m
         .indices
         .iter()
@@ -661,8 +698,13 @@ fn validate_mesh(m: &MeshDesc, span: &Span) -> Result<(), BuildError> {
             ),
         );
     }
-    if m.positions.iter().chain(&m.normals).any(|p| !p.is_finite())
+    if m.positions
+        .iter()
+        .chain(&m.normals)
+        .chain(&m.colors)
+        .any(|p| !p.is_finite())
         || m.uvs.iter().any(|uv| !uv.is_finite())
+        || m.tangents.iter().any(|t| !t.is_finite())
     {
         return err(span, "mesh has a non-finite vertex attribute");
     }
@@ -670,7 +712,8 @@ fn validate_mesh(m: &MeshDesc, span: &Span) -> Result<(), BuildError> {
 }
 
 fn to_world(local: MeshDesc, m: Mat4, material: MaterialId) -> Mesh {
-    let normal_matrix = Mat3::from_mat4(m).inverse().transpose();
+    let linear = Mat3::from_mat4(m);
+    let normal_matrix = linear.inverse().transpose();
     Mesh {
         positions: local
             .positions
@@ -683,6 +726,21 @@ fn to_world(local: MeshDesc, m: Mat4, material: MaterialId) -> Mesh {
             .map(|&n| (normal_matrix * n).normalize_or_zero())
             .collect(),
         uvs: local.uvs,
+        colors: local.colors,
+        // Tangents are directions: transformed by the linear part. A mirroring transform
+        // reverses n × t against the transformed bitangent, so it flips the handedness.
+        tangents: local
+            .tangents
+            .iter()
+            .map(|t| {
+                let w = if linear.determinant() < 0.0 {
+                    -t.w
+                } else {
+                    t.w
+                };
+                (linear * t.truncate()).normalize_or_zero().extend(w)
+            })
+            .collect(),
         indices: local.indices,
         material,
         lights: Vec::new(),
@@ -708,6 +766,8 @@ pub fn rectangle() -> MeshDesc {
             Vec2::new(0.0, 1.0),
         ],
         indices: vec![[0, 1, 2], [0, 2, 3]],
+        colors: Vec::new(),
+        tangents: Vec::new(),
     }
 }
 
@@ -730,6 +790,8 @@ pub fn disk(segments: u32) -> MeshDesc {
         positions,
         uvs,
         indices,
+        colors: Vec::new(),
+        tangents: Vec::new(),
     }
 }
 

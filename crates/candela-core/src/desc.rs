@@ -9,7 +9,7 @@
 use std::fmt;
 use std::sync::Arc;
 
-use glam::{Affine2, Mat3, Mat4, Vec2, Vec3};
+use glam::{Affine2, Mat3, Mat4, Vec2, Vec3, Vec4};
 
 /// Where an item of a description came from: `file:line:col` (1-based). Items made in code
 /// have an empty file name and line 0.
@@ -174,6 +174,9 @@ pub enum BsdfDesc {
         alpha_u: f32,
         alpha_v: f32,
         thin: bool,
+        /// Multiplies transmission only (glTF's base colour under KHR_materials_transmission);
+        /// constant one for clear glass. Not for thin sheets.
+        tint: TextureDesc,
     },
     /// A diffuse base under a smooth dielectric coat of index `eta`.
     Plastic { albedo: TextureDesc, eta: f32 },
@@ -306,13 +309,20 @@ pub enum GeometryDesc {
     Cube,
 }
 
-/// An indexed triangle mesh. `normals` and `uvs` are either empty or one per position.
+/// An indexed triangle mesh. `normals`, `uvs` and `colors` are either empty or one per
+/// position.
 #[derive(Clone, Debug, Default)]
 pub struct MeshDesc {
     pub positions: Vec<Vec3>,
     pub normals: Vec<Vec3>,
     pub uvs: Vec<Vec2>,
     pub indices: Vec<[u32; 3]>,
+    /// Linear RGB vertex colours (glTF COLOR_0), multiplying the material's base colour
+    /// (diffuse and plastic albedo, metal_rough base colour) where given.
+    pub colors: Vec<Vec3>,
+    /// Tangents (glTF TANGENT): xyz along +u, w = ±1 the handedness, so the bitangent of
+    /// a normal map is w·(n × t). Where empty, normal maps use ∂p/∂u of the uvs.
+    pub tangents: Vec<Vec4>,
 }
 
 /// A light that is not a shape.

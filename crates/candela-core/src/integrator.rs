@@ -227,8 +227,7 @@ pub fn li<S: Sampler>(scene: &Scene, mut ray: Ray, sampler: &mut S, rays: &mut u
             break;
         }
 
-        let bsdf =
-            scene.materials[si.material.0 as usize].bsdf_with_tangent(si.ns, si.ng, si.uv, si.dpdu);
+        let bsdf = scene.materials[si.material.0 as usize].bsdf_at(&si);
         let ctx = ShadingCtx { p: si.p, n: si.ns };
         let (u_light, u_point) = (sampler.get_1d(), sampler.get_2d());
         if !bsdf.is_delta() {

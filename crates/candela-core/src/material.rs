@@ -2,8 +2,9 @@
 
 use glam::{Vec2, Vec3};
 
-use crate::bsdf::{Bsdf, Diffuse, Lobe, MetalRough, Plastic};
+use crate::bsdf::{Bsdf, Dielectric, Diffuse, Lobe, MetalRough, Plastic};
 use crate::math::Frame;
+use crate::scene::SurfaceInteraction;
 pub use crate::texture::Texture;
 
 /// Index of a material in [`crate::Scene::materials`].
@@ -28,6 +29,12 @@ pub enum Material {
         metallic: Texture,
         roughness: Texture,
     },
+    /// A rough or smooth dielectric whose transmission is tinted by a texture (times the
+    /// vertex colour); `lobe` is a template whose tint is replaced.
+    Dielectric {
+        tint: Texture,
+        lobe: Dielectric,
+    },
     /// Bends the shading normal by a tangent-space normal map before the inner material.
     NormalMap {
         map: Texture,
@@ -47,27 +54,50 @@ impl Material {
 
     /// The BSDF with `dpdu` (the surface's ∂p/∂u) giving the tangent of the shading frame.
     pub fn bsdf_with_tangent(&self, ns: Vec3, ng: Vec3, uv: Vec2, dpdu: Vec3) -> Bsdf {
+        self.bsdf_at(&SurfaceInteraction {
+            p: Vec3::ZERO,
+            t: 0.0,
+            ng,
+            ns,
+            uv,
+            dpdu,
+            bitangent_sign: 1.0,
+            color: Vec3::ONE,
+            material: MaterialId(0),
+            light: None,
+        })
+    }
+
+    /// The BSDF at a surface interaction: its shading frame (tangent `dpdu`, bitangent
+    /// sign), uvs, and vertex colour multiplying the base colour (diffuse and plastic
+    /// albedo, metal_rough base colour; other lobes ignore it).
+    pub fn bsdf_at(&self, si: &SurfaceInteraction) -> Bsdf {
         match self {
             Material::NormalMap { map, inner } => {
-                let n = normal_mapped(ns, ng, dpdu, map.eval(uv));
-                inner.bsdf_with_tangent(n, ng, uv, dpdu)
+                let texel = map.eval(si.uv);
+                let ns = normal_mapped(si.ns, si.ng, si.dpdu, si.bitangent_sign, texel);
+                inner.bsdf_at(&SurfaceInteraction { ns, ..*si })
             }
             Material::OneSided(inner) => Bsdf {
                 one_sided: true,
-                ..inner.bsdf_with_tangent(ns, ng, uv, dpdu)
+                ..inner.bsdf_at(si)
             },
-            _ => Bsdf::with_tangent(ns, ng, dpdu, self.lobe(uv)),
+            _ => Bsdf::with_tangent(si.ns, si.ng, si.dpdu, self.lobe(si.uv, si.color)),
         }
     }
 
-    fn lobe(&self, uv: Vec2) -> Lobe {
+    fn lobe(&self, uv: Vec2, color: Vec3) -> Lobe {
         match self {
             Material::Diffuse { albedo } => Lobe::Diffuse(Diffuse {
-                albedo: albedo.eval(uv),
+                albedo: albedo.eval(uv) * color,
             }),
             Material::Fixed(lobe) => *lobe,
+            Material::Dielectric { tint, lobe } => Lobe::Dielectric(Dielectric {
+                tint: tint.eval(uv) * color,
+                ..*lobe
+            }),
             Material::Plastic { albedo, coat } => Lobe::Plastic(Plastic {
-                albedo: albedo.eval(uv).min(Vec3::ONE),
+                albedo: (albedo.eval(uv) * color).min(Vec3::ONE),
                 ..*coat
             }),
             Material::MetalRough {
@@ -75,20 +105,21 @@ impl Material {
                 metallic,
                 roughness,
             } => Lobe::MetalRough(MetalRough::new(
-                base_color.eval(uv),
+                base_color.eval(uv) * color,
                 metallic.eval_scalar(uv),
                 roughness.eval_scalar(uv),
             )),
-            Material::NormalMap { inner, .. } | Material::OneSided(inner) => inner.lobe(uv),
+            Material::NormalMap { inner, .. } | Material::OneSided(inner) => inner.lobe(uv, color),
         }
     }
 }
 
 /// The shading normal a tangent-space normal map asks for, decoded as glTF stores it
-/// (c·2 − 1). Never NaN, and never more than ~84° from the geometric normal's side: a
+/// (c·2 − 1), in the frame (t, sign·(ns × t), ns) with t = `dpdu` made orthogonal to
+/// `ns` (glTF's bitangent rule: `sign` is TANGENT's w, or −1 where the uvs are mirrored). Never NaN, and never more than ~84° from the geometric normal's side: a
 /// degenerate map value or one that would face away from the surface falls back to `ns`,
 /// so the reflection/transmission test against `ng` stays meaningful.
-pub fn normal_mapped(ns: Vec3, ng: Vec3, dpdu: Vec3, texel: Vec3) -> Vec3 {
+pub fn normal_mapped(ns: Vec3, ng: Vec3, dpdu: Vec3, sign: f32, texel: Vec3) -> Vec3 {
     let m = texel * 2.0 - Vec3::ONE;
     let t = (dpdu - ns * ns.dot(dpdu)).normalize_or_zero();
     let t = if t == Vec3::ZERO {
@@ -96,7 +127,7 @@ pub fn normal_mapped(ns: Vec3, ng: Vec3, dpdu: Vec3, texel: Vec3) -> Vec3 {
     } else {
         t
     };
-    let b = ns.cross(t);
+    let b = ns.cross(t) * sign;
     let n = (t * m.x + b * m.y + ns * m.z).normalize_or_zero();
     let ng = if ng.dot(ns) < 0.0 { -ng } else { ng };
     if !n.is_finite() || n.dot(ng) < 0.1 {
@@ -114,10 +145,10 @@ mod tests {
     fn normal_map_follows_the_tangent_and_never_faces_away() {
         let (ns, ng, dpdu) = (Vec3::Z, Vec3::Z, Vec3::X);
         // The flat texel (0.5, 0.5, 1) keeps the normal.
-        let flat = normal_mapped(ns, ng, dpdu, Vec3::new(0.5, 0.5, 1.0));
+        let flat = normal_mapped(ns, ng, dpdu, 1.0, Vec3::new(0.5, 0.5, 1.0));
         assert!((flat - Vec3::Z).length() < 1e-6);
         // Tilted towards +u.
-        let n = normal_mapped(ns, ng, dpdu, Vec3::new(0.85, 0.5, 0.85));
+        let n = normal_mapped(ns, ng, dpdu, 1.0, Vec3::new(0.85, 0.5, 0.85));
         assert!(
             n.x > 0.3 && n.y.abs() < 1e-6 && (n.length() - 1.0).abs() < 1e-5,
             "{n}"
@@ -130,7 +161,7 @@ mod tests {
             Vec3::NAN,
         ] {
             for t in [Vec3::X, Vec3::ZERO, Vec3::Z, Vec3::NAN] {
-                let n = normal_mapped(ns, ng, t, texel);
+                let n = normal_mapped(ns, ng, t, 1.0, texel);
                 assert!(n.is_finite() && n.dot(ng) >= 0.1, "{texel} {t}: {n}");
             }
         }

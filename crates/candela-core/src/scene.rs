@@ -1,7 +1,7 @@
 //! The render-time scene: flat arrays addressed by small ids, a BVH over all primitives,
 //! and the queries the integrator asks of them.
 
-use glam::{Vec2, Vec3};
+use glam::{Vec2, Vec3, Vec4};
 
 use crate::accel::Accel;
 use crate::camera::Camera;
@@ -21,6 +21,11 @@ pub struct Mesh {
     pub normals: Vec<Vec3>,
     /// Empty, or one per position.
     pub uvs: Vec<Vec2>,
+    /// Empty, or one linear RGB vertex colour per position (see [`crate::desc::MeshDesc`]).
+    pub colors: Vec<Vec3>,
+    /// Empty, or one tangent per position: xyz along +u, w = ±1 the handedness (see
+    /// [`crate::desc::MeshDesc`]).
+    pub tangents: Vec<Vec4>,
     pub indices: Vec<[u32; 3]>,
     pub material: MaterialId,
     /// Light of each triangle, if the mesh emits (same length as `indices`).
@@ -92,6 +97,12 @@ pub struct SurfaceInteraction {
     /// ∂p/∂u, the direction of increasing u (zero where the uvs are degenerate): the
     /// tangent of normal maps and anisotropic roughness.
     pub dpdu: Vec3,
+    /// ±1: the bitangent of a normal map is `bitangent_sign`·(ns × dpdu). −1 where the uvs
+    /// are mirrored (∂p/∂v points against ng × ∂p/∂u) or a file's tangent says so.
+    pub bitangent_sign: f32,
+    /// The interpolated vertex colour multiplying the base colour; one where the mesh has
+    /// none (and on spheres).
+    pub color: Vec3,
     pub material: MaterialId,
     pub light: Option<LightId>,
 }
@@ -218,10 +229,26 @@ impl Scene {
                     m.uvs[a] * b0 + m.uvs[b] * bary.x + m.uvs[c] * bary.y
                 };
                 let light = m.lights.get(tri as usize).copied();
-                let dpdu = if m.uvs.is_empty() {
-                    p1 - p0
+                let (dpdu, bitangent_sign) = if !m.tangents.is_empty() {
+                    let t = m.tangents[a] * b0 + m.tangents[b] * bary.x + m.tangents[c] * bary.y;
+                    (t.truncate(), if t.w < 0.0 { -1.0 } else { 1.0 })
+                } else if m.uvs.is_empty() {
+                    (p1 - p0, 1.0)
                 } else {
-                    triangle_dpdu([p0, p1, p2], [m.uvs[a], m.uvs[b], m.uvs[c]])
+                    let (dpdu, dpdv) =
+                        triangle_dpdu_dpdv([p0, p1, p2], [m.uvs[a], m.uvs[b], m.uvs[c]]);
+                    // Mirrored uvs: +v lies against ng × ∂p/∂u.
+                    let sign = if ng.cross(dpdu).dot(dpdv) < 0.0 {
+                        -1.0
+                    } else {
+                        1.0
+                    };
+                    (dpdu, sign)
+                };
+                let color = if m.colors.is_empty() {
+                    Vec3::ONE
+                } else {
+                    m.colors[a] * b0 + m.colors[b] * bary.x + m.colors[c] * bary.y
                 };
                 SurfaceInteraction {
                     p,
@@ -230,6 +257,8 @@ impl Scene {
                     ns,
                     uv,
                     dpdu,
+                    bitangent_sign,
+                    color,
                     material: m.material,
                     light,
                 }
@@ -253,6 +282,8 @@ impl Scene {
                     uv,
                     // u grows with φ = atan2(z, x): along (−z, 0, x) of the normal.
                     dpdu: Vec3::new(-n_out.z, 0.0, n_out.x),
+                    bitangent_sign: 1.0,
+                    color: Vec3::ONE,
                     material: s.material,
                     light: s.light,
                 }
@@ -261,19 +292,20 @@ impl Scene {
     }
 }
 
-/// ∂p/∂u of a triangle from its positions and uvs (pbrt-v4 §6.5.3); zero when the uvs
-/// are degenerate.
-fn triangle_dpdu(p: [Vec3; 3], uv: [Vec2; 3]) -> Vec3 {
+/// ∂p/∂u and ∂p/∂v of a triangle from its positions and uvs (pbrt-v4 §6.5.3); zero when
+/// the uvs are degenerate.
+fn triangle_dpdu_dpdv(p: [Vec3; 3], uv: [Vec2; 3]) -> (Vec3, Vec3) {
     let (duv02, duv12) = (uv[0] - uv[2], uv[1] - uv[2]);
     let (dp02, dp12) = (p[0] - p[2], p[1] - p[2]);
     let det = duv02.x * duv12.y - duv02.y * duv12.x;
     if det.abs() < 1e-12 {
-        return Vec3::ZERO;
+        return (Vec3::ZERO, Vec3::ZERO);
     }
     let dpdu = (duv12.y * dp02 - duv02.y * dp12) / det;
-    if dpdu.is_finite() {
-        dpdu
+    let dpdv = (duv02.x * dp12 - duv12.x * dp02) / det;
+    if dpdu.is_finite() && dpdv.is_finite() {
+        (dpdu, dpdv)
     } else {
-        Vec3::ZERO
+        (Vec3::ZERO, Vec3::ZERO)
     }
 }

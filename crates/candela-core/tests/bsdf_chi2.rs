@@ -157,6 +157,7 @@ fn rough_dielectric_over_the_whole_sphere() {
             for th in [first, 40.0, 75.0, 89.0, 110.0, 170.0] {
                 seed += 1;
                 let lobe = Lobe::Dielectric(Dielectric {
+                    tint: Vec3::ONE,
                     eta,
                     distrib: TrowbridgeReitz::new(alpha, alpha),
                 });
@@ -170,6 +171,7 @@ fn rough_dielectric_over_the_whole_sphere() {
         }
     }
     let lobe = Lobe::Dielectric(Dielectric {
+        tint: Vec3::ONE,
         eta: 1.33,
         distrib: TrowbridgeReitz::new(0.1, 0.4),
     });

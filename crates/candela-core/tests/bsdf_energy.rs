@@ -126,6 +126,7 @@ fn white_furnace_conductor() {
 fn no_bsdf_returns_more_than_it_receives() {
     let glass = |eta, a| {
         Lobe::Dielectric(Dielectric {
+            tint: Vec3::ONE,
             eta,
             distrib: TrowbridgeReitz::new(a, a),
         })
@@ -179,6 +180,7 @@ fn no_bsdf_returns_more_than_it_receives() {
 #[test]
 fn lossless_layers_return_one() {
     let smooth = Lobe::Dielectric(Dielectric {
+        tint: Vec3::ONE,
         eta: 1.5,
         distrib: TrowbridgeReitz::new(1e-4, 1e-4),
     });
@@ -215,6 +217,7 @@ fn reflection_is_reciprocal() {
             },
         }),
         Lobe::Dielectric(Dielectric {
+            tint: Vec3::ONE,
             eta: 1.5,
             distrib: TrowbridgeReitz::new(0.4, 0.4),
         }),

@@ -222,6 +222,7 @@ pub(crate) fn parse_material(
                 alpha_u,
                 alpha_v,
                 thin: m.thin.unwrap_or(false),
+                tint: TextureDesc::Constant(Vec3::ONE),
             }
         }
         "plastic" => BsdfDesc::Plastic {

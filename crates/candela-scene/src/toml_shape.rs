@@ -328,6 +328,8 @@ fn inline_mesh(
             v.into_inner().into_iter().map(V2::vec2).collect()
         }),
         indices: indices.into_inner(),
+        colors: Vec::new(),
+        tangents: Vec::new(),
     })
 }
 

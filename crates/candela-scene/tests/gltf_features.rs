@@ -64,7 +64,7 @@ fn feature_file() -> Glb {
     }));
     let m1 = g.material(json!({
         "name": "glass",
-        "pbrMetallicRoughness": {"roughnessFactor": 0.2},
+        "pbrMetallicRoughness": {"roughnessFactor": 0.2, "baseColorFactor": [0.9, 0.8, 0.7, 0.5]},
         "alphaMode": "BLEND",
         "extensions": {"KHR_materials_transmission": {"transmissionFactor": 1.0},
                        "KHR_materials_ior": {"ior": 1.33}}
@@ -258,11 +258,14 @@ fn every_feature_round_trips_into_the_expected_description() {
         alpha_u,
         alpha_v,
         thin,
+        tint: TextureDesc::Constant(tint),
     } = **inner
     else {
         panic!()
     };
     assert_eq!((eta, thin), (1.33, false));
+    // Transmission is tinted by the base colour.
+    assert_eq!(tint, Vec3::new(0.9, 0.8, 0.7));
     assert!((alpha_u - 0.04).abs() < 1e-6 && alpha_u == alpha_v);
     // The fan has no material: glTF's default (white, metallic 1, roughness 1).
     let m2 = material(d, &d.shapes[3].material);
@@ -555,4 +558,206 @@ fn scene_option_picks_a_scene_and_a_missing_one_is_an_error() {
         e.to_string().contains("scene 5 does not exist (2 scenes)"),
         "{e}"
     );
+}
+
+/// A unit quad whose vertices carry COLOR_0 `colors` (accessor index), material 0 default.
+fn colored_quad(g: &mut Glb, colors: usize) {
+    let m = g.material(json!({}));
+    let mut q = g.quad(m);
+    q["attributes"]["COLOR_0"] = json!(colors);
+    let mesh = g.mesh(vec![q]);
+    g.node(json!({"mesh": mesh}), true);
+}
+
+#[test]
+fn vertex_colors_round_trip_from_normalized_bytes_and_floats() {
+    // Normalized u8 RGBA (alpha 255): c/255, linear, no sRGB decoding.
+    let mut g = Glb::new();
+    let bytes = [
+        255u8, 0, 0, 255, 0, 255, 0, 255, 0, 0, 51, 255, 255, 255, 255, 255,
+    ];
+    let view = g.view(&bytes);
+    g.json["accessors"].as_array_mut().unwrap().push(json!({
+        "bufferView": view, "componentType": 5121, "normalized": true, "count": 4,
+        "type": "VEC4"}));
+    let acc = g.json["accessors"].as_array().unwrap().len() - 1;
+    colored_quad(&mut g, acc);
+    let loaded = parse(&g).unwrap();
+    assert!(
+        loaded.warnings.iter().all(|w| !w.contains("COLOR")),
+        "{:?}",
+        loaded.warnings
+    );
+    let GeometryDesc::Mesh(m) = &loaded.desc.shapes[0].geometry else {
+        panic!("not a mesh")
+    };
+    let want = [Vec3::X, Vec3::Y, Vec3::new(0.0, 0.0, 0.2), Vec3::ONE];
+    for (c, w) in m.colors.iter().zip(want) {
+        assert!((*c - w).abs().max_element() < 1e-6, "{c} vs {w}");
+    }
+    assert_eq!(m.colors.len(), 4);
+
+    // Float RGBA with a translucent alpha: RGB read, the ignored alpha warned.
+    let mut g = Glb::new();
+    let acc = g.floats(&[0.5, 0.25, 1.0, 0.5].repeat(4), 4, "VEC4");
+    colored_quad(&mut g, acc);
+    let loaded = parse(&g).unwrap();
+    let GeometryDesc::Mesh(m) = &loaded.desc.shapes[0].geometry else {
+        panic!("not a mesh")
+    };
+    assert_eq!(m.colors, vec![Vec3::new(0.5, 0.25, 1.0); 4]);
+    assert!(
+        loaded
+            .warnings
+            .iter()
+            .any(|w| w.contains("alpha of COLOR_0")),
+        "{:?}",
+        loaded.warnings
+    );
+
+    // A colour count that does not match the positions is a located error.
+    let mut g = Glb::new();
+    let acc = g.floats(&[1.0; 9], 3, "VEC3");
+    colored_quad(&mut g, acc);
+    let e = parse(&g).unwrap_err();
+    assert!(e.contains("COLOR_0 has 3 elements for 4 positions"), "{e}");
+}
+
+#[test]
+fn vertex_colors_multiply_the_albedo_of_a_lit_diffuse_quad() {
+    // Red at x = −1, green at x = +1: the colour (1 − x, 1 + x, 0)/2 is linear in x, so
+    // barycentric interpolation gives it exactly on both triangles. A 683 lux sun from
+    // straight above gives E = 1 W/m²; a white Lambertian albedo then gives radiance
+    // colour·1/π. Every sample sees R + G = 1/π and B = 0 (tolerance: f32 rounding), and
+    // the column means of (G − R)/(G + R) follow the x of the column centre: the samples
+    // spread over the filter's footprint, symmetric about the centre, so the mean of a
+    // linear colour is its centre value up to sampling imbalance (measured 6·10⁻⁴; the
+    // bound 0.02 is a tenth of a pixel on the plane). Without colours R = G everywhere;
+    // swapped colours flip the sign: both fail by ~0.7 at the edge columns.
+    let mut g = Glb::new();
+    let acc = g.floats(&[1., 0., 0., 0., 1., 0., 0., 1., 0., 1., 0., 0.], 3, "VEC3");
+    colored_quad(&mut g, acc);
+    g.json["extensions"] =
+        json!({"KHR_lights_punctual": {"lights": [{"type": "directional", "intensity": 683.0}]}});
+    g.node(
+        json!({"extensions": {"KHR_lights_punctual": {"light": 0}}}),
+        true,
+    );
+    // Half-height tan(0.25)·3 = 0.77 on the plane: the view stays inside the quad.
+    g.json["cameras"] = json!([{"type": "perspective",
+        "perspective": {"yfov": 0.5, "aspectRatio": 1.0, "znear": 0.1}}]);
+    g.node(json!({"camera": 0, "translation": [0.0, 0.0, 3.0]}), true);
+    let mut desc = parse(&g).unwrap().desc;
+    for mat in &mut desc.materials {
+        mat.bsdf = BsdfDesc::Diffuse {
+            albedo: TextureDesc::Constant(Vec3::ONE),
+        };
+    }
+    let (w, h) = (8usize, 8usize);
+    desc.render.width = w as u32;
+    desc.render.height = h as u32;
+    desc.render.spp = 16;
+    desc.render.max_depth = 1;
+    let scene = candela_core::build::build(&desc).unwrap();
+    let r = candela_core::integrator::render(&scene, 0..16, &AtomicBool::new(false), &|_| {});
+    let px = r.film.resolve();
+    let inv_pi = std::f32::consts::FRAC_1_PI;
+    for p in &px {
+        assert!(
+            ((p.x + p.y) / inv_pi - 1.0).abs() < 1e-3 && p.z.abs() < 1e-6,
+            "pixel {p}, expected R + G = 1/π, B = 0"
+        );
+    }
+    let half = 0.25f32.tan() * 3.0; // tan(yfov/2)·distance
+    let mut worst = 0.0f32;
+    for col in 0..w {
+        let x = (2.0 * (col as f32 + 0.5) / w as f32 - 1.0) * half;
+        let (mut r_, mut g_) = (0.0, 0.0);
+        for row in 0..h {
+            r_ += px[row * w + col].x;
+            g_ += px[row * w + col].y;
+        }
+        let measured = (g_ - r_) / (g_ + r_);
+        worst = worst.max((measured - x).abs());
+        assert!(
+            (measured - x).abs() < 0.02,
+            "column {col}: (G − R)/(G + R) = {measured}, expected x = {x}"
+        );
+    }
+    eprintln!("vertex colours: worst column deviation {worst} (plane units)");
+}
+
+/// The normal-mapped shading normals at world (−0.5, 0.2) and (0.5, 0.2) of a quad in z = 0
+/// made of two halves: x ∈ [0, 1] with u = x, and x ∈ [−1, 0] with u = −x (mirrored uvs),
+/// v up along +y on both, under a normal map of one texel `c`. `tangents` adds TANGENT
+/// ((1,0,0,1) on the right, (−1,0,0,−1) on the mirrored left); `mirror` places the mesh
+/// with scale (−1, 1, 1).
+fn mapped_normals(c: u8, tangents: bool, mirror: bool) -> [Vec3; 2] {
+    let mut g = Glb::new();
+    let tex = g.texture(&png(1, 1, |_, _| [c, c, c, 255]), None);
+    let m = g.material(json!({"normalTexture": {"index": tex}}));
+    #[rustfmt::skip]
+    let pos = g.floats(&[
+        0., -1., 0., 1., -1., 0., 1., 1., 0., 0., 1., 0.,
+        0., -1., 0., -1., -1., 0., -1., 1., 0., 0., 1., 0.,
+    ], 3, "VEC3");
+    let nrm = g.floats(&[0., 0., 1.].repeat(8), 3, "VEC3");
+    // glTF v runs down: v = 0 at y = +1.
+    #[rustfmt::skip]
+    let uv = g.floats(&[0., 1., 1., 1., 1., 0., 0., 0., 0., 1., 1., 1., 1., 0., 0., 0.], 2, "VEC2");
+    let idx = g.indices(&[0, 1, 2, 0, 2, 3, 4, 6, 5, 4, 7, 6]);
+    let mut attributes = json!({"POSITION": pos, "NORMAL": nrm, "TEXCOORD_0": uv});
+    if tangents {
+        let mut t = [1., 0., 0., 1.].repeat(4);
+        t.extend([-1., 0., 0., -1.].repeat(4));
+        attributes["TANGENT"] = json!(g.floats(&t, 4, "VEC4"));
+    }
+    let mesh = g.mesh(vec![
+        json!({"attributes": attributes, "indices": idx, "material": m}),
+    ]);
+    let scale = if mirror { -1.0 } else { 1.0 };
+    g.node(json!({"mesh": mesh, "scale": [scale, 1.0, 1.0]}), true);
+    let loaded = parse(&g).unwrap();
+    assert!(
+        loaded.warnings.iter().all(|w| !w.contains("TANGENT")),
+        "{:?}",
+        loaded.warnings
+    );
+    let scene = candela_core::build::build(&loaded.desc).unwrap();
+    [-0.5f32, 0.5].map(|x| {
+        let ray = candela_core::geometry::Ray::new(Vec3::new(x, 0.2, 3.0), -Vec3::Z);
+        let si = scene.intersect(&ray, f32::INFINITY).expect("hits the quad");
+        scene.materials[si.material.0 as usize].bsdf_at(&si).frame.n
+    })
+}
+
+#[test]
+fn normal_maps_shade_mirrored_uv_halves_with_the_right_bitangent() {
+    // The texel c = 217 decodes to m = 2c/255 − 1 = 0.702 on all three axes: tilted
+    // towards +u and +v. +v is +y on both halves; +u is +x on the right and −x on the
+    // mirrored left. So the right half must shade with normalize(m, m, m) and the left
+    // with normalize(−m, m, m) — whether the frame comes from TANGENT or from the uvs,
+    // and under a mirroring node transform (which maps each half onto the other's place).
+    // A bitangent n × t without the sign gives (−m, −m, m) on the mirrored half. The
+    // tolerance 10⁻⁴ is f32 rounding of the frame and the 8-bit texel is exact.
+    let m = 2.0 * 217.0 / 255.0 - 1.0;
+    let want = [
+        Vec3::new(-m, m, m).normalize(),
+        Vec3::new(m, m, m).normalize(),
+    ];
+    for tangents in [false, true] {
+        for mirror in [false, true] {
+            let got = mapped_normals(217, tangents, mirror);
+            eprintln!(
+                "tangents {tangents}, mirror {mirror}: left {}, right {}",
+                got[0], got[1]
+            );
+            for (g, w) in got.iter().zip(want) {
+                assert!(
+                    (*g - w).length() < 1e-4,
+                    "tangents {tangents}, mirror {mirror}: normal {g}, expected {w}"
+                );
+            }
+        }
+    }
 }

@@ -150,6 +150,7 @@ fn dielectrics_read_numbers_and_named_indices() {
             alpha_u,
             alpha_v,
             thin,
+            ..
         } => {
             assert!((eta - 1.333 / 1.5).abs() < 1e-6);
             assert_eq!((alpha_u, alpha_v, thin), (0.2, 0.2, false));

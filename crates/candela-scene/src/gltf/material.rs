@@ -11,8 +11,9 @@
 //! - Alpha: `MASK` and `BLEND` wrap the BSDF in [`BsdfDesc::Alpha`] with α = base colour
 //!   alpha factor × texture alpha.
 //! - KHR_materials_transmission with factor ≥ ½ makes a rough dielectric of index
-//!   KHR_materials_ior (default 1.5) and α = roughness²; the base-colour tint and partial
-//!   factors are not modelled (warned).
+//!   KHR_materials_ior (default 1.5) and α = roughness², its transmission tinted by the
+//!   base colour (factor × texture, times vertex colours); partial factors are not
+//!   modelled (warned).
 //! - `doubleSided` wraps the BSDF in [`BsdfDesc::TwoSided`]; Candela's BSDFs reflect on
 //!   both sides either way (a path tracer does not cull back faces).
 //! - Samplers: wrap S (T must agree, else a warning) as the texture's wrap mode; lookups
@@ -130,17 +131,13 @@ impl Materials {
             {
                 ctx.warn(format!("{path}: transmission texture ignored (taken as 1)"));
             }
-            if base_factor != Vec3::ONE || pbr.base_color_texture().is_some() {
-                ctx.warn(format!(
-                    "{path}: the base colour tint of transmission is ignored"
-                ));
-            }
             let alpha = pbr.roughness_factor().clamp(0.0, 1.0).powi(2);
             BsdfDesc::Dielectric {
                 eta: ior,
                 alpha_u: alpha,
                 alpha_v: alpha,
                 thin: false,
+                tint: base_color,
             }
         } else {
             if transmission > 0.0 {

@@ -6,16 +6,22 @@
 //!   skipped with a warning. Without indices the vertices are taken in order.
 //! - Normals: read where given; where missing they are left out, and the renderer shades
 //!   with the triangle's geometric normal — the flat normals glTF prescribes.
+//! - Vertex colours: COLOR_0's RGB (float or normalized u8/u16, linear) multiplies the
+//!   base colour; its alpha is not read (a warning says so where it is below 1).
 //! - Texture coordinates: the set (TEXCOORD_0 or _1) that the material's textures name,
 //!   with v flipped (glTF's v runs down the image, Candela's up).
-//! - Tangents: the renderer derives the normal-map frame from ∂p/∂u of the uvs; TANGENT
-//!   is not read (a warning says so where a normal map meets one).
+//! - Tangents: TANGENT is read where the material has a normal map (bitangent
+//!   w·(n × t), glTF 2.0 §3.7.2.1). Where it is missing, the renderer generates the frame
+//!   per triangle from the uvs: t = ∂p/∂u, and the bitangent's sign is that of
+//!   (ng × ∂p/∂u)·∂p/∂v, so mirrored-uv regions get the right one. Not smoothed per vertex
+//!   and not MikkTSpace: per-triangle frames need no vertex splitting at mirror seams and
+//!   no dependency, at the cost of faceted tangents on curved low-poly meshes.
 
 use std::collections::HashMap;
 use std::sync::Arc;
 
 use candela_core::desc::{GeometryDesc, MeshDesc, ShapeDesc};
-use glam::{Mat4, Vec2, Vec3};
+use glam::{Mat4, Vec2, Vec3, Vec4};
 use gltf::mesh::Mode;
 
 use super::material::Materials;
@@ -44,19 +50,8 @@ pub(crate) fn place_mesh(
             Some(d) => d.clone(),
             None => {
                 let path = format!("meshes[{}].primitives[{}]", mesh.index(), prim.index());
-                let d = read_primitive(ctx, &prim, mat.tex_coord, &path)?.map(Arc::new);
-                if d.is_some()
-                    && mat.has_normal_map
-                    && prim.get(&gltf::Semantic::Tangents).is_some()
-                {
-                    ctx.warn(format!(
-                        "{path}: TANGENT is not read; normal maps use the tangent ∂p/∂u \
-                         of the texture coordinates"
-                    ));
-                }
-                if prim.get(&gltf::Semantic::Colors(0)).is_some() {
-                    ctx.warn(format!("{path}: vertex colors (COLOR_0) are ignored"));
-                }
+                let d = read_primitive(ctx, &prim, mat.tex_coord, mat.has_normal_map, &path)?
+                    .map(Arc::new);
                 if prim.morph_targets().next().is_some() {
                     ctx.warn(format!("{path}: morph targets are ignored"));
                 }
@@ -98,6 +93,7 @@ fn read_primitive(
     ctx: &mut Ctx,
     prim: &gltf::Primitive,
     tex_coord: u32,
+    normal_map: bool,
     path: &str,
 ) -> Result<Option<MeshDesc>, LoadError> {
     let mode = prim.mode();
@@ -132,7 +128,35 @@ fn read_primitive(
             None => return Err(unreadable(ctx, path, &format!("TEXCOORD_{tex_coord}"), &a)),
         },
     };
-    for (what, len) in [("NORMAL", normals.len()), ("TEXCOORD", uvs.len())] {
+    // COLOR_0 (RGB or RGBA, float or normalized u8/u16) is linear; the crate decodes it.
+    let mut colors: Vec<Vec3> = Vec::new();
+    let mut translucent = false;
+    if let Some(a) = prim.get(&gltf::Semantic::Colors(0)) {
+        let Some(it) = reader.read_colors(0) else {
+            return Err(unreadable(ctx, path, "COLOR_0", &a));
+        };
+        colors = it
+            .into_rgba_f32()
+            .map(|[r, g, b, alpha]| {
+                translucent |= alpha < 1.0;
+                Vec3::new(r, g, b)
+            })
+            .collect();
+    }
+    // TANGENT only matters to a normal map.
+    let tangents: Vec<Vec4> = match prim.get(&gltf::Semantic::Tangents) {
+        Some(a) if normal_map => match reader.read_tangents() {
+            Some(it) => it.map(Vec4::from).collect(),
+            None => return Err(unreadable(ctx, path, "TANGENT", &a)),
+        },
+        _ => Vec::new(),
+    };
+    for (what, len) in [
+        ("NORMAL", normals.len()),
+        ("TANGENT", tangents.len()),
+        ("TEXCOORD", uvs.len()),
+        ("COLOR_0", colors.len()),
+    ] {
         if len != 0 && len != n {
             return Err(ctx.error(path, format!("{what} has {len} elements for {n} positions")));
         }
@@ -147,13 +171,23 @@ fn read_primitive(
     if let Some(&i) = order.iter().find(|&&i| i as usize >= n) {
         return Err(ctx.error(path, format!("index {i} is out of range ({n} vertices)")));
     }
+    if translucent {
+        ctx.warn(format!(
+            "{path}: the alpha of COLOR_0 is ignored (only its RGB multiplies the base colour)"
+        ));
+    }
     let indices = triangulate(mode, &order);
     if indices.is_empty() {
         ctx.warn(format!("{path}: has no triangles and is skipped"));
         return Ok(None);
     }
-    if positions.iter().chain(&normals).any(|p| !p.is_finite())
+    if positions
+        .iter()
+        .chain(&normals)
+        .chain(&colors)
+        .any(|p| !p.is_finite())
         || uvs.iter().any(|uv| !uv.is_finite())
+        || tangents.iter().any(|t| !t.is_finite())
     {
         return Err(ctx.error(path, "has a non-finite vertex attribute"));
     }
@@ -162,6 +196,8 @@ fn read_primitive(
         normals,
         uvs,
         indices,
+        colors,
+        tangents,
     }))
 }
 

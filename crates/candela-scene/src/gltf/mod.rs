@@ -4,7 +4,8 @@
 //! section; in short:
 //!
 //! - [`mesh`]: triangles, strips and fans, indexed or not; missing normals give flat
-//!   shading (the rule glTF 2.0 §3.7.2.1 prescribes); tangents come from ∂p/∂u.
+//!   shading (the rule glTF 2.0 §3.7.2.1 prescribes); COLOR_0 multiplies the base
+//!   colour; TANGENT frames normal maps, or ∂p/∂u with the uv orientation's sign.
 //! - [`material`]: metallic-roughness, normal maps with scale, emission, alpha modes,
 //!   KHR_materials_{emissive_strength, ior, transmission}, KHR_texture_transform.
 //! - [`light`]: KHR_lights_punctual in candela and lux, converted at 683 lm/W by the build.

@@ -107,6 +107,7 @@ fn two_sided(ctx: &mut Ctx, node: &Node) -> Result<BsdfDesc, LoadError> {
                 alpha_u,
                 alpha_v,
                 thin: kind == "thindielectric",
+                tint: TextureDesc::Constant(Vec3::ONE),
             }
         }
         "plastic" | "roughplastic" => {
