@@ -1,59 +1,17 @@
 //! End-to-end tests of the `candela` binary: files written, exit codes, located errors,
 //! determinism, interruption.
 
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+use std::path::PathBuf;
+use std::process::Command;
 
-const SCENE: &str = r#"
-[render]
-resolution = [24, 16]
-spp = 4
-max_depth = 3
-
-[camera]
-type = "pinhole"
-position = [0, 1, 4]
-look_at = [0, 1, 0]
-fov = 45
-
-[materials.white]
-type = "diffuse"
-albedo = 0.7
-
-[[shape]]
-type = "rectangle"
-material = "white"
-transform = [{ rotate = { axis = [1, 0, 0], angle = -90 } }, { scale = 3 }]
-
-[[shape]]
-type = "sphere"
-center = [0, 1, 0]
-radius = 0.5
-material = "white"
-emission = [4, 3, 2]
-
-[[light]]
-type = "point"
-position = [1, 3, 1]
-intensity = 5
-"#;
-
-fn candela(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_candela"))
-        .args(args)
-        .output()
-        .expect("candela runs")
-}
+mod common;
+use common::{candela, s, SCENE};
 
 fn scene_dir(text: &str) -> (tempfile::TempDir, PathBuf) {
     let dir = tempfile::tempdir().unwrap();
     let scene = dir.path().join("scene.toml");
     std::fs::write(&scene, text).unwrap();
     (dir, scene)
-}
-
-fn s(p: &Path) -> &str {
-    p.to_str().unwrap()
 }
 
 #[test]

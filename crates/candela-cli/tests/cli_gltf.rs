@@ -3,14 +3,9 @@
 //! relight it, `--scene` picks a scene, and broken files exit 2 with a located message.
 
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
 
-fn candela(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_candela"))
-        .args(args)
-        .output()
-        .expect("candela runs")
-}
+mod common;
+use common::candela;
 
 fn example() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes/gltf/spheres.gltf")

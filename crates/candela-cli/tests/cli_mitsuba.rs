@@ -1,6 +1,7 @@
 //! `candela render`/`info` on Mitsuba XML: `-D name=value`, `--lenient`, located errors.
 
-use std::process::{Command, Output};
+mod common;
+use common::candela;
 
 const SCENE: &str = r#"<scene version="3.0.0">
     <default name="res" value="16"/>
@@ -14,13 +15,6 @@ const SCENE: &str = r#"<scene version="3.0.0">
     <shape type="sphere"><emitter type="area"><rgb name="radiance" value="1"/></emitter></shape>
     <shape type="rectangle"><bsdf type="$material"/></shape>
 </scene>"#;
-
-fn candela(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_candela"))
-        .args(args)
-        .output()
-        .expect("candela runs")
-}
 
 #[test]
 fn defines_set_parameters_and_lenient_skips_what_is_unsupported() {

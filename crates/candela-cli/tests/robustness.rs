@@ -3,47 +3,11 @@
 //! atomically, and a write that fails (disk full, a path that cannot exist, a read-only
 //! folder) leaves the previous output byte for byte.
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::process::{Command, Output, Stdio};
 
-const SCENE: &str = r#"
-[render]
-resolution = [24, 16]
-spp = 4
-max_depth = 3
-
-[camera]
-type = "pinhole"
-position = [0, 1, 4]
-look_at = [0, 1, 0]
-fov = 45
-
-[materials.white]
-type = "diffuse"
-albedo = 0.7
-
-[[shape]]
-type = "rectangle"
-material = "white"
-transform = [{ rotate = { axis = [1, 0, 0], angle = -90 } }, { scale = 3 }]
-
-[[light]]
-type = "point"
-position = [1, 3, 1]
-intensity = 5
-"#;
-
-fn candela() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_candela"))
-}
-
-fn run(args: &[&str]) -> Output {
-    candela().args(args).output().expect("candela runs")
-}
-
-fn s(p: &Path) -> &str {
-    p.to_str().unwrap()
-}
+mod common;
+use common::{candela, command, s, SCENE};
 
 /// A folder holding `scene.toml` (SCENE plus `extra`) and the given files.
 fn scene_with(extra: &str, files: &[(&str, &[u8])]) -> (tempfile::TempDir, PathBuf) {
@@ -113,7 +77,7 @@ fn every_loader_error_is_one_located_line_with_exit_2() {
     ];
     for (extra, file, needles) in cases {
         let (dir, scene) = scene_with(&extra, &[file]);
-        let o = run(&["render", s(&scene), "-o", s(&dir.path().join("x.png"))]);
+        let o = candela(&["render", s(&scene), "-o", s(&dir.path().join("x.png"))]);
         assert_user_error(&o, &needles);
         assert!(!dir.path().join("x.png").exists());
     }
@@ -141,14 +105,14 @@ fn mitsuba_errors_are_located_lines_with_exit_2() {
     for (xml, needles) in cases {
         let scene = dir.path().join("m.xml");
         std::fs::write(&scene, xml).unwrap();
-        let o = run(&["render", s(&scene), "-o", s(&dir.path().join("x.png"))]);
+        let o = candela(&["render", s(&scene), "-o", s(&dir.path().join("x.png"))]);
         assert_user_error(&o, needles);
     }
 }
 
 #[test]
 fn an_internal_error_exits_101_and_asks_for_a_report() {
-    let o = candela()
+    let o = command()
         .args(["info", "x.toml"])
         .env("CANDELA_TEST_INTERNAL_ERROR", "1")
         .output()
@@ -165,7 +129,7 @@ fn sigterm_writes_the_partial_image_atomically() {
     let (dir, scene) = scene_with("", &[]);
     let out = dir.path().join("partial.pfm");
     std::fs::write(&out, b"previous image").unwrap();
-    let child = candela()
+    let child = command()
         .args([
             "render",
             s(&scene),
@@ -247,7 +211,7 @@ fn paths_that_cannot_be_written_are_clear_errors() {
     let file = dir.path().join("a-file");
     std::fs::write(&file, b"x").unwrap();
     for out in [file.join("x.png"), PathBuf::from("/proc/candela-test.png")] {
-        let o = run(&["render", s(&scene), "-o", s(&out)]);
+        let o = candela(&["render", s(&scene), "-o", s(&out)]);
         assert_user_error(&o, &[&format!("{}: cannot write:", out.display())]);
     }
     assert_eq!(std::fs::read(&file).unwrap(), b"x");
@@ -267,7 +231,7 @@ fn a_read_only_folder_keeps_the_previous_output_intact() {
     let out = ro.join("keep.png");
     std::fs::write(&out, b"previous image").unwrap();
     std::fs::set_permissions(&ro, std::fs::Permissions::from_mode(0o555)).unwrap();
-    let o = run(&["render", s(&scene), "-o", s(&out)]);
+    let o = candela(&["render", s(&scene), "-o", s(&out)]);
     std::fs::set_permissions(&ro, std::fs::Permissions::from_mode(0o755)).unwrap();
     assert_user_error(&o, &["keep.png: cannot write:"]);
     assert_eq!(std::fs::read(&out).unwrap(), b"previous image");
@@ -283,13 +247,13 @@ fn a_resolution_past_the_pixel_cap_is_an_error_not_an_abort() {
     )
     .unwrap();
     let out = dir.path().join("x.png");
-    let o = run(&["render", s(&huge), "-o", s(&out)]);
+    let o = candela(&["render", s(&huge), "-o", s(&out)]);
     assert_user_error(&o, &["huge.toml:3:14:", "100000x100000", "more than"]);
-    let o = run(&["render", s(&scene), "-o", s(&out), "--res", "100000x100000"]);
+    let o = candela(&["render", s(&scene), "-o", s(&out), "--res", "100000x100000"]);
     assert_eq!(o.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&o.stderr).contains("more than"));
     // A wide image under the cap is not refused.
-    let o = run(&[
+    let o = candela(&[
         "render",
         s(&scene),
         "-o",
