@@ -120,9 +120,10 @@ def reference(scene: str, tag: str, params: dict, a, variant: str, source: str) 
     meta_path = path + ".json"
     if os.path.exists(path) and os.path.exists(meta_path):
         with open(meta_path) as f:
-            if all(json.load(f).get(k) == v for k, v in want.items()):
-                print(f"[compare] {tag}: reusing {os.path.relpath(path, REPO)}", flush=True)
-                return path
+            meta = json.load(f)
+        if all(meta.get(k) == v for k, v in want.items()):
+            print(f"[compare] {tag}: reusing {os.path.relpath(path, REPO)}", flush=True)
+            return path
     print(f"[compare] {tag}: rendering the reference, {passes} × {REF_PASS_SPP} spp with "
           f"{variant} (cached in bench/out/compare/)", flush=True)
     r = mitsuba_render.run(scene, path, variant=variant, threads=a.threads,
