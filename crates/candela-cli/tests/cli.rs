@@ -1,8 +1,7 @@
 //! End-to-end tests of the `candela` binary: files written, exit codes, located errors,
-//! determinism, interruption.
+//! determinism (interruption: robustness.rs).
 
 use std::path::PathBuf;
-use std::process::Command;
 
 mod common;
 use common::{candela, s, SCENE};
@@ -177,50 +176,6 @@ fn info_reports_the_environment() {
 }
 
 #[cfg(unix)]
-#[test]
-fn interrupt_writes_the_partial_image() {
-    let (dir, scene) = scene_dir(SCENE);
-    let out = dir.path().join("partial.pfm");
-    // Enough samples to be still rendering when the signal arrives.
-    let child = Command::new(env!("CARGO_BIN_EXE_candela"))
-        .args([
-            "render",
-            s(&scene),
-            "-o",
-            s(&out),
-            "--spp",
-            "2000000",
-            "--threads",
-            "1",
-        ])
-        .stdout(std::process::Stdio::piped())
-        .stderr(std::process::Stdio::piped())
-        .spawn()
-        .unwrap();
-    std::thread::sleep(std::time::Duration::from_millis(1500));
-    let killed = Command::new("kill")
-        .args(["-INT", &child.id().to_string()])
-        .status()
-        .unwrap();
-    assert!(killed.success());
-    let o = child.wait_with_output().unwrap();
-    assert_eq!(
-        o.status.code(),
-        Some(130),
-        "{}",
-        String::from_utf8_lossy(&o.stderr)
-    );
-    assert!(String::from_utf8_lossy(&o.stderr).contains("partial image"));
-    let bytes = std::fs::read(&out).unwrap();
-    assert!(bytes.starts_with(b"PF\n24 16\n"));
-    // The partial image is a real image: some pixel is lit.
-    let floats: Vec<f32> = bytes[b"PF\n24 16\n-1.0\n".len()..]
-        .chunks(4)
-        .map(|c| f32::from_le_bytes(c.try_into().unwrap()))
-        .collect();
-    assert!(floats.iter().any(|&v| v > 0.0) && floats.iter().all(|v| v.is_finite()));
-}
-
 #[test]
 fn lens_flags_blur_the_render_and_bad_values_are_located_errors() {
     let (dir, scene) = scene_dir(SCENE);

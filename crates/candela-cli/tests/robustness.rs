@@ -1,7 +1,7 @@
 //! The CLI under hostile input and failure: every loader's error is one located line
-//! with exit 2, a panic is exit 101 asking for a report, SIGTERM writes the partial image
-//! atomically, and a write that fails (disk full, a path that cannot exist, a read-only
-//! folder) leaves the previous output byte for byte.
+//! with exit 2, a panic is exit 101 asking for a report, SIGTERM and Ctrl-C write the
+//! partial image atomically, and a write that fails (disk full, a path that cannot
+//! exist, a read-only folder) leaves the previous output byte for byte.
 
 use std::path::PathBuf;
 use std::process::{Command, Output, Stdio};
@@ -123,9 +123,9 @@ fn an_internal_error_exits_101_and_asks_for_a_report() {
     assert!(err.contains("please report it"), "{err}");
 }
 
-#[cfg(unix)]
-#[test]
-fn sigterm_writes_the_partial_image_atomically() {
+/// Sends `signal` to a long render and checks that the previous file was replaced by a
+/// whole partial image, atomically.
+fn a_signal_writes_the_partial_image_atomically(signal: &str) {
     let (dir, scene) = scene_with("", &[]);
     let out = dir.path().join("partial.pfm");
     std::fs::write(&out, b"previous image").unwrap();
@@ -146,7 +146,7 @@ fn sigterm_writes_the_partial_image_atomically() {
         .unwrap();
     std::thread::sleep(std::time::Duration::from_millis(1500));
     let killed = Command::new("kill")
-        .args(["-TERM", &child.id().to_string()])
+        .args([signal, &child.id().to_string()])
         .status()
         .unwrap();
     assert!(killed.success());
@@ -174,6 +174,18 @@ fn sigterm_writes_the_partial_image_atomically() {
         .map(|e| e.unwrap().file_name().into_string().unwrap())
         .collect();
     assert!(names.iter().all(|n| !n.ends_with(".tmp")), "{names:?}");
+}
+
+#[cfg(unix)]
+#[test]
+fn sigterm_writes_the_partial_image_atomically() {
+    a_signal_writes_the_partial_image_atomically("-TERM");
+}
+
+#[cfg(unix)]
+#[test]
+fn ctrl_c_writes_the_partial_image_atomically() {
+    a_signal_writes_the_partial_image_atomically("-INT");
 }
 
 /// Whether this process runs as root (for whom a read-only folder is still writable).
