@@ -22,7 +22,7 @@ use glam::Vec2;
 
 use crate::geometry::{Ray, TriangleHit};
 use crate::sampler::mix64;
-use crate::scene::{Mesh, Prim, Scene};
+use crate::scene::{Prim, Scene};
 use crate::texture::Texture;
 
 /// How a mesh's α hides it.
@@ -68,18 +68,6 @@ pub fn hit_uniform(ray: &Ray, mesh: u32, tri: u32) -> f32 {
         h = mix64(h ^ v.to_bits() as u64);
     }
     (h >> 40) as f32 / (1u64 << 24) as f32
-}
-
-impl Mesh {
-    /// Texture coordinates at barycentrics (b1, b2) of a triangle (the barycentrics
-    /// themselves where the mesh has no uvs, as [`Scene::intersect`] reports them).
-    pub fn uv_at(&self, tri: u32, bary: Vec2) -> Vec2 {
-        if self.uvs.is_empty() {
-            return bary;
-        }
-        let [a, b, c] = self.indices[tri as usize].map(|i| i as usize);
-        self.uvs[a] * (1.0 - bary.x - bary.y) + self.uvs[b] * bary.x + self.uvs[c] * bary.y
-    }
 }
 
 impl Scene {

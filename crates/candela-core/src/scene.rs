@@ -46,6 +46,16 @@ impl Mesh {
         ]
     }
 
+    /// Texture coordinates at barycentrics (b1, b2) of a triangle (the barycentrics
+    /// themselves where the mesh has no uvs, as [`Scene::intersect`] reports them).
+    pub fn uv_at(&self, tri: u32, bary: Vec2) -> Vec2 {
+        if self.uvs.is_empty() {
+            return bary;
+        }
+        let [a, b, c] = self.indices[tri as usize].map(|i| i as usize);
+        self.uvs[a] * (1.0 - bary.x - bary.y) + self.uvs[b] * bary.x + self.uvs[c] * bary.y
+    }
+
     /// Unit geometric normal of a triangle: from the winding, turned towards the shading
     /// normals where the mesh has them, and flipped by `flip_normals`. Zero for a
     /// degenerate triangle.
@@ -223,11 +233,7 @@ impl Scene {
                         ns = if m.flip_normals { -n } else { n };
                     }
                 }
-                let uv = if m.uvs.is_empty() {
-                    Vec2::new(bary.x, bary.y)
-                } else {
-                    m.uvs[a] * b0 + m.uvs[b] * bary.x + m.uvs[c] * bary.y
-                };
+                let uv = m.uv_at(tri, bary);
                 let light = m.lights.get(tri as usize).copied();
                 let (dpdu, bitangent_sign) = if !m.tangents.is_empty() {
                     let t = m.tangents[a] * b0 + m.tangents[b] * bary.x + m.tangents[c] * bary.y;
