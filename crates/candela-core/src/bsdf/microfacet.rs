@@ -66,12 +66,16 @@ impl TrowbridgeReitz {
     }
 
     /// Density of visible normals from `w`: G₁(ω)/|cos θ| · D(ωm) · |ω·ωm| (Heitz 2014,
-    /// eq. 38); back-facing normals (ω·ωm < 0) are invisible. Integrates to 1 over ωm.
+    /// eq. 38); back-facing normals are invisible. From below (`w.z < 0`) the surface is
+    /// seen mirrored, as [`Self::sample_wm`] samples it: the density is that seen from
+    /// −`w`, so a normal is visible where ω·ωm has the sign of cos θ. Integrates to 1
+    /// over ωm from either side.
     pub fn d_visible(&self, w: Vec3, wm: Vec3) -> f32 {
         if w.z == 0.0 {
             return 0.0;
         }
-        self.g1(w) / w.z.abs() * self.d(wm) * w.dot(wm).max(0.0)
+        let cos_m = w.dot(wm) * w.z.signum();
+        self.g1(w) / w.z.abs() * self.d(wm) * cos_m.max(0.0)
     }
 
     /// Samples a visible normal seen from `w` (either hemisphere: `w` is mirrored to the
@@ -109,9 +113,13 @@ mod tests {
     fn distribution_and_visible_normals_are_normalized() {
         for (ax, ay) in [(0.5, 0.5), (0.2, 0.6), (0.05, 0.05)] {
             let m = TrowbridgeReitz::new(ax, ay);
-            let w = Vec3::new(0.5, 0.2, 0.6).normalize();
+            // From above, and from below (the mirrored view that `sample_wm` samples).
+            let (w, w_below) = (
+                Vec3::new(0.5, 0.2, 0.6).normalize(),
+                Vec3::new(0.5, 0.2, -0.6).normalize(),
+            );
             let (nt, np) = (4000, 256);
-            let (mut proj, mut vis) = (0.0f64, 0.0f64);
+            let (mut proj, mut vis, mut vis_below) = (0.0f64, 0.0f64, 0.0f64);
             for i in 0..nt {
                 let th = (i as f32 + 0.5) / nt as f32 * PI / 2.0;
                 for j in 0..np {
@@ -120,10 +128,15 @@ mod tests {
                     let dw = (th.sin() * (PI / 2.0 / nt as f32) * (2.0 * PI / np as f32)) as f64;
                     proj += (m.d(wm) * wm.z) as f64 * dw;
                     vis += m.d_visible(w, wm) as f64 * dw;
+                    vis_below += m.d_visible(w_below, wm) as f64 * dw;
                 }
             }
             assert!((proj - 1.0).abs() < 5e-3, "α=({ax},{ay}): ∫D cos = {proj}");
             assert!((vis - 1.0).abs() < 5e-3, "α=({ax},{ay}): ∫D_ω = {vis}");
+            assert!(
+                (vis_below - 1.0).abs() < 5e-3,
+                "α=({ax},{ay}): ∫D_ω from below = {vis_below}"
+            );
         }
     }
 }
