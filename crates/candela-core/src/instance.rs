@@ -277,3 +277,64 @@ impl Instances {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn skewed(mirror: bool) -> Transform {
+        let s = Vec3::new(if mirror { -2.0 } else { 2.0 }, 0.5, 1.5);
+        Transform::new(Mat4::from_scale_rotation_translation(
+            s,
+            glam::Quat::from_rotation_y(0.7) * glam::Quat::from_rotation_x(0.3),
+            Vec3::new(1.0, -2.0, 3.0),
+        ))
+    }
+
+    #[test]
+    fn normals_stay_perpendicular_and_tangents_keep_their_handedness() {
+        for mirror in [false, true] {
+            let xf = skewed(mirror);
+            // A surface spanned by e1, e2 with normal e1 × e2.
+            let (e1, e2) = (Vec3::new(1.0, 0.2, 0.0), Vec3::new(0.1, 1.0, 0.4));
+            let n = xf.normal(e1.cross(e2));
+            let (w1, w2) = (
+                xf.point(e1) - xf.point(Vec3::ZERO),
+                xf.point(e2) - xf.point(Vec3::ZERO),
+            );
+            assert!(n.dot(w1).abs() < 1e-5 && n.dot(w2).abs() < 1e-5, "{n}");
+            assert!((n.length() - 1.0).abs() < 1e-6);
+            // The winding's normal flips under a mirror; the carried normal does not.
+            assert_eq!(w1.cross(w2).dot(n) < 0.0, mirror);
+            let t = xf.tangent(e1.normalize().extend(1.0));
+            assert!(t.truncate().abs_diff_eq(w1.normalize(), 1e-5));
+            assert_eq!(t.w, if mirror { -1.0 } else { 1.0 });
+            // The inverse takes world points back.
+            let p = Vec3::new(0.3, -0.7, 2.0);
+            assert!(xf
+                .to_object
+                .transform_point3(xf.point(p))
+                .abs_diff_eq(p, 1e-5));
+        }
+    }
+
+    #[test]
+    fn world_bounds_hold_every_carried_point() {
+        let xf = skewed(true);
+        let b = Aabb {
+            min: Vec3::new(-1.0, -2.0, 0.5),
+            max: Vec3::new(3.0, 1.0, 0.75),
+        };
+        let w = xf.bounds(b);
+        for i in 0..1000u32 {
+            let f = |k: u32| ((i.wrapping_mul(2654435761) >> k) & 255) as f32 / 255.0;
+            let p = b.min + (b.max - b.min) * Vec3::new(f(0), f(8), f(16));
+            let q = xf.point(p);
+            assert!(
+                q.cmpge(w.min).all() && q.cmple(w.max).all(),
+                "{q} outside {w:?}"
+            );
+        }
+        assert!(xf.bounds(Aabb::EMPTY).is_empty());
+    }
+}
