@@ -328,3 +328,17 @@ fn gltf_nodes_sharing_a_mesh_become_instances() {
         ],
     );
 }
+
+#[test]
+fn gallery_scene_stores_its_knot_once() {
+    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../../scenes/instances.toml");
+    let desc = load_scene(Path::new(path)).unwrap_or_else(|e| panic!("{e}"));
+    let scene = candela_core::build::build(&desc).unwrap_or_else(|e| panic!("{e}"));
+    let knot = scene.instances.meshes[0].indices.len();
+    assert_eq!(knot, 12288);
+    assert_eq!(scene.instances.instances.len(), 400);
+    assert_eq!(scene.instances.meshes.len(), 1);
+    // The floor and the light are rectangles, flattened.
+    assert_eq!(scene.stored_triangle_count(), knot + 4);
+    assert_eq!(scene.triangle_count(), 400 * knot + 4);
+}
