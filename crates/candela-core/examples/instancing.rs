@@ -106,7 +106,7 @@ fn main() {
     // the placements, not the scene's, whose instance boxes are looser).
     let b = candela_core::geometry::Aabb {
         min: Vec3::new(-1.5, -1.5, -1.5),
-        max: Vec3::new(3.0 * side as f32, 1.5, 3.0 * ((n + side - 1) / side) as f32),
+        max: Vec3::new(3.0 * side as f32, 1.5, 3.0 * n.div_ceil(side) as f32),
     };
     let o = Vec3::new(b.min.x - 5.0, b.max.y + 10.0, b.min.z - 5.0);
     let rays = 200_000;
