@@ -20,7 +20,17 @@ pub fn run(path: &Path, load: &LoadArgs) -> Result<(), UserError> {
         scene.meshes.len(),
         scene.spheres.len()
     );
-    println!("triangles  {}", scene.triangle_count());
+    if scene.instances.is_empty() {
+        println!("triangles  {}", scene.triangle_count());
+    } else {
+        println!(
+            "triangles  {} rendered, {} stored ({} instances of {} shared meshes)",
+            scene.triangle_count(),
+            scene.stored_triangle_count(),
+            scene.instances.instances.len(),
+            scene.instances.meshes.len()
+        );
+    }
     println!(
         "lights     {} ({} emitting triangles, {} spheres, {} points, {} environments), total power {:.4} W",
         scene.lights.len(),

@@ -226,7 +226,9 @@ pub fn run(args: RenderArgs) -> Result<ExitCode, UserError> {
     let mut desc = args.load.load(&args.scene)?;
     args.apply_overrides(&mut desc);
     args.apply_environment(&mut desc)?;
+    let built = Instant::now();
     let scene = candela_core::build::build(&desc)?;
+    let build_s = built.elapsed().as_secs_f64();
     let s = &scene.settings;
 
     let threads = args.threads.unwrap_or(0);
@@ -273,6 +275,16 @@ pub fn run(args: RenderArgs) -> Result<ExitCode, UserError> {
         st.rays as f64 / elapsed / 1e6,
         args.output.display()
     );
+    if !scene.instances.is_empty() {
+        println!(
+            "{} instances of {} shared meshes: {} triangles stored, {} rendered; built in {:.2} s",
+            scene.instances.instances.len(),
+            scene.instances.meshes.len(),
+            scene.stored_triangle_count(),
+            scene.triangle_count(),
+            build_s
+        );
+    }
     let rejected = result.film.rejected_samples();
     if rejected > 0 {
         println!("{rejected} non-finite samples were dropped");

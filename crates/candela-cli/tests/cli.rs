@@ -149,6 +149,36 @@ fn info_describes_the_scene() {
 }
 
 #[test]
+fn info_and_render_report_instanced_triangles() {
+    let (dir, scene) = scene_dir(&format!(
+        "{SCENE}
+[[shape]]
+type = \"mesh\"
+positions = [[0, 0, -2], [1, 0, -2], [0, 1, -2]]
+indices = [[0, 1, 2]]
+material = \"white\"
+instances = [[], [{{ translate = [-1, 0, 0] }}], [{{ translate = [0, -1, 0] }}]]
+"
+    ));
+    let o = candela(&["info", s(&scene)]);
+    assert!(o.status.success());
+    let text = String::from_utf8_lossy(&o.stdout);
+    // The base scene's 2 triangles, and 3 instances of 1.
+    assert!(
+        text.contains("triangles  5 rendered, 3 stored (3 instances of 1 shared meshes)"),
+        "{text}"
+    );
+    let out = dir.path().join("x.png");
+    let o = candela(&["render", s(&scene), "-o", s(&out), "--spp", "1"]);
+    assert!(o.status.success());
+    let text = String::from_utf8_lossy(&o.stdout);
+    assert!(
+        text.contains("3 instances of 1 shared meshes: 3 triangles stored, 5 rendered"),
+        "{text}"
+    );
+}
+
+#[test]
 fn info_reports_the_environment() {
     // A 100×50 panorama, black but for one texel: all power in the brightest 1%.
     let (dir, scene) = scene_dir(&format!(

@@ -93,6 +93,28 @@ impl Scene {
             Prim::Sphere(_) => true,
         }
     }
+
+    /// The instances' filter: whether `hit` on triangle `tri` of instance `inst` counts.
+    /// The hit's uniform number hashes the world-space ray, so every instance of a mesh
+    /// decides independently; instance ids are kept apart from mesh ids by the top bit.
+    #[inline]
+    pub fn instance_alpha_accepts(
+        &self,
+        inst: u32,
+        tri: u32,
+        hit: &TriangleHit,
+        ray: &Ray,
+    ) -> bool {
+        let i = &self.instances.instances[inst as usize];
+        match &i.alpha {
+            None => true,
+            Some(alpha) => {
+                let m = &self.instances.meshes[i.mesh as usize];
+                let uv = m.uv_at(tri, Vec2::new(hit.b1, hit.b2));
+                !alpha.rejects(uv, hit_uniform(ray, inst | 1 << 31, tri))
+            }
+        }
+    }
 }
 
 #[cfg(test)]

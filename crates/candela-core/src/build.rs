@@ -4,6 +4,7 @@
 
 use std::collections::HashMap;
 use std::fmt;
+use std::sync::Arc;
 
 use glam::{Mat3, Mat4, Vec2, Vec3};
 
@@ -20,6 +21,7 @@ use crate::desc::{
 };
 use crate::filter::PixelFilter;
 use crate::geometry::Aabb;
+use crate::instance::{Instance, Instances, Transform};
 use crate::light::envmap::{Cubemap, Equirect, Image};
 use crate::light::{EnvironmentLight, EnvironmentMap, Light, LightId, SphereLight};
 use crate::light_sampler::LightSampler;
@@ -117,6 +119,11 @@ pub fn build(desc: &SceneDesc) -> Result<Scene, BuildError> {
     let mut spheres = Vec::new();
     let mut lights = Vec::new();
     lights::check_emission_profiles(desc)?;
+    let shared = shared_meshes(desc);
+    // Object-space mesh of each shared `MeshDesc`, by its address.
+    let mut object_mesh: HashMap<*const MeshDesc, u32> = HashMap::new();
+    let mut object_meshes = Vec::new();
+    let mut instances = Vec::new();
     for (shape_index, shape) in desc.shapes.iter().enumerate() {
         let Some(&material) = material_ids.get(shape.material.as_str()) else {
             return err(
@@ -154,6 +161,21 @@ pub fn build(desc: &SceneDesc) -> Result<Scene, BuildError> {
                     LightId(lights.len() as u32 - 1)
                 });
                 spheres.push(Sphere { light, ..sphere });
+            }
+            GeometryDesc::Mesh(m) if emission.is_none() && shared.contains(&Arc::as_ptr(m)) => {
+                let next = object_meshes.len() as u32;
+                let mesh = *object_mesh.entry(Arc::as_ptr(m)).or_insert(next);
+                if mesh == next {
+                    validate_mesh(m, &shape.span)?;
+                    object_meshes.push(object_space(MeshDesc::clone(m), material));
+                }
+                instances.push(Instance {
+                    mesh,
+                    transform: Transform::new(shape.transform),
+                    material,
+                    flip_normals: shape.flip_normals,
+                    alpha: alphas[material.0 as usize].clone(),
+                });
             }
             geometry => {
                 let local = match geometry {
@@ -204,7 +226,12 @@ pub fn build(desc: &SceneDesc) -> Result<Scene, BuildError> {
         Prim::Triangle { mesh, .. } => meshes[mesh as usize].alpha.is_some(),
         Prim::Sphere(_) => false,
     });
-    let bounds = shapes.iter().map(Shape::bounds).reduce(Aabb::union);
+    let instances = Instances::new(object_meshes, instances);
+    let bounds = shapes
+        .iter()
+        .map(Shape::bounds)
+        .chain((!instances.is_empty()).then(|| instances.bounds()))
+        .reduce(Aabb::union);
     let scene_radius = bounds.map_or(1.0, |b| (0.5 * (b.max - b.min).length()).max(1e-3));
     for light in &mut lights {
         if let Light::Directional(d) = light {
@@ -234,7 +261,29 @@ pub fn build(desc: &SceneDesc) -> Result<Scene, BuildError> {
         light_sampler,
         prims,
         accel,
+        instances,
     })
+}
+
+/// The meshes to instance: those that two or more non-emitting shapes hold (the same
+/// `Arc`). A mesh placed once gains nothing from a BLAS of its own and would cost every
+/// ray a detour through the TLAS, so it is flattened into world space with the rest;
+/// emitting shapes stay flattened because each of their triangles is an area light in
+/// world space.
+fn shared_meshes(desc: &SceneDesc) -> std::collections::HashSet<*const MeshDesc> {
+    let mut count: HashMap<*const MeshDesc, u32> = HashMap::new();
+    for shape in &desc.shapes {
+        if let GeometryDesc::Mesh(m) = &shape.geometry {
+            if shape.emission.is_none_or(|le| le == Vec3::ZERO) {
+                *count.entry(Arc::as_ptr(m)).or_default() += 1;
+            }
+        }
+    }
+    count
+        .into_iter()
+        .filter(|&(_, n)| n >= 2)
+        .map(|(m, _)| m)
+        .collect()
 }
 
 fn check_image(span: &Span, what: &str, img: &ImageDesc) -> Result<(), BuildError> {
@@ -712,35 +761,31 @@ fn validate_mesh(m: &MeshDesc, span: &Span) -> Result<(), BuildError> {
 }
 
 fn to_world(local: MeshDesc, m: Mat4, material: MaterialId) -> Mesh {
-    let linear = Mat3::from_mat4(m);
-    let normal_matrix = linear.inverse().transpose();
+    let xf = Transform::new(m);
     Mesh {
-        positions: local
-            .positions
-            .iter()
-            .map(|&p| m.transform_point3(p))
-            .collect(),
-        normals: local
-            .normals
-            .iter()
-            .map(|&n| (normal_matrix * n).normalize_or_zero())
-            .collect(),
+        positions: local.positions.iter().map(|&p| xf.point(p)).collect(),
+        normals: local.normals.iter().map(|&n| xf.normal(n)).collect(),
         uvs: local.uvs,
         colors: local.colors,
-        // Tangents are directions: transformed by the linear part. A mirroring transform
-        // reverses n × t against the transformed bitangent, so it flips the handedness.
-        tangents: local
-            .tangents
-            .iter()
-            .map(|t| {
-                let w = if linear.determinant() < 0.0 {
-                    -t.w
-                } else {
-                    t.w
-                };
-                (linear * t.truncate()).normalize_or_zero().extend(w)
-            })
-            .collect(),
+        tangents: local.tangents.iter().map(|&t| xf.tangent(t)).collect(),
+        indices: local.indices,
+        material,
+        lights: Vec::new(),
+        flip_normals: false,
+        alpha: None,
+    }
+}
+
+/// A shared mesh as its instances read it: the description's vertex data untouched
+/// (normals and tangents not yet normalised), so that an instance's [`Transform`] makes
+/// of it exactly what [`to_world`] makes of the same mesh.
+fn object_space(local: MeshDesc, material: MaterialId) -> Mesh {
+    Mesh {
+        positions: local.positions,
+        normals: local.normals,
+        uvs: local.uvs,
+        colors: local.colors,
+        tangents: local.tangents,
         indices: local.indices,
         material,
         lights: Vec::new(),

@@ -39,6 +39,7 @@ pub mod desc;
 pub mod film;
 pub mod filter;
 pub mod geometry;
+pub mod instance;
 pub mod integrator;
 pub mod light;
 pub mod light_sampler;

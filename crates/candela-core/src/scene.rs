@@ -8,6 +8,7 @@ use crate::camera::Camera;
 use crate::desc::RenderSettings;
 use crate::filter::PixelFilter;
 use crate::geometry::{Aabb, Ray};
+use crate::instance::{Instance, Instances};
 use crate::light::{Light, LightId};
 use crate::light_sampler::LightSampler;
 use crate::material::{Material, MaterialId};
@@ -60,20 +61,27 @@ impl Mesh {
     /// normals where the mesh has them, and flipped by `flip_normals`. Zero for a
     /// degenerate triangle.
     pub fn geometric_normal(&self, tri: u32) -> Vec3 {
-        let [p0, p1, p2] = self.vertices(tri);
-        let mut n = (p1 - p0).cross(p2 - p0).normalize_or_zero();
-        if !self.normals.is_empty() {
-            let [a, b, c] = self.indices[tri as usize];
-            let ns = self.normals[a as usize] + self.normals[b as usize] + self.normals[c as usize];
-            if n.dot(ns) < 0.0 {
-                n = -n;
-            }
+        let [a, b, c] = self.indices[tri as usize].map(|i| i as usize);
+        let normals =
+            (!self.normals.is_empty()).then(|| self.normals[a] + self.normals[b] + self.normals[c]);
+        winding_normal(self.vertices(tri), normals, self.flip_normals)
+    }
+}
+
+/// The unit normal of the winding of `p`, turned towards `normals` (the sum of the
+/// vertices' shading normals) where given, and flipped by `flip`.
+fn winding_normal(p: [Vec3; 3], normals: Option<Vec3>, flip: bool) -> Vec3 {
+    let [p0, p1, p2] = p;
+    let mut n = (p1 - p0).cross(p2 - p0).normalize_or_zero();
+    if let Some(ns) = normals {
+        if n.dot(ns) < 0.0 {
+            n = -n;
         }
-        if self.flip_normals {
-            -n
-        } else {
-            n
-        }
+    }
+    if flip {
+        -n
+    } else {
+        n
     }
 }
 
@@ -145,14 +153,26 @@ pub struct Scene {
     /// Every primitive, in the order of [`Scene::accel`]'s primitive indices.
     pub prims: Vec<Prim>,
     pub accel: Accel,
+    /// Meshes shared by several shapes, stored once and placed by transforms.
+    pub instances: Instances,
 }
 
 impl Scene {
     pub fn bounds(&self) -> Aabb {
-        self.accel.bounds()
+        self.accel.bounds().union(self.instances.bounds())
     }
 
+    /// Triangles as rendered: each instance counts its mesh's triangles.
     pub fn triangle_count(&self) -> usize {
+        self.flat_triangle_count() + self.instances.instanced_triangles()
+    }
+
+    /// Triangles held in memory: flattened meshes plus each shared mesh once.
+    pub fn stored_triangle_count(&self) -> usize {
+        self.flat_triangle_count() + self.instances.stored_triangles()
+    }
+
+    fn flat_triangle_count(&self) -> usize {
         self.meshes.iter().map(|m| m.indices.len()).sum()
     }
 
@@ -164,7 +184,23 @@ impl Scene {
     pub fn intersect(&self, ray: &Ray, t_max: f32) -> Option<SurfaceInteraction> {
         let hit = self
             .accel
-            .intersect(ray, t_max, |i, hit| self.alpha_accepts(i, hit, ray))?;
+            .intersect(ray, t_max, |i, hit| self.alpha_accepts(i, hit, ray));
+        if !self.instances.is_empty() {
+            let t_flat = hit.map_or(t_max, |h| h.t);
+            let filter = |inst, tri, hit: &_| self.instance_alpha_accepts(inst, tri, hit, ray);
+            if let Some(h) = self.instances.intersect(ray, t_flat, filter) {
+                let inst = &self.instances.instances[h.instance as usize];
+                let m = &self.instances.meshes[inst.mesh as usize];
+                return Some(triangle_interaction(
+                    m,
+                    Some(inst),
+                    h.tri,
+                    h.t,
+                    Vec2::new(h.b1, h.b2),
+                ));
+            }
+        }
+        let hit = hit?;
         let prim = self.prims[hit.prim as usize];
         Some(self.interaction(ray, prim, hit.t, Vec2::new(hit.b1, hit.b2)))
     }
@@ -173,6 +209,10 @@ impl Scene {
     pub fn occluded(&self, ray: &Ray, t_max: f32) -> bool {
         self.accel
             .occluded(ray, t_max, |i, hit| self.alpha_accepts(i, hit, ray))
+            || (!self.instances.is_empty()
+                && self.instances.occluded(ray, t_max, |inst, tri, hit| {
+                    self.instance_alpha_accepts(inst, tri, hit, ray)
+                }))
     }
 
     /// Whether the segment from surface point `from` (normal `n_from`) to point `to`
@@ -218,56 +258,7 @@ impl Scene {
     fn interaction(&self, ray: &Ray, prim: Prim, t: f32, bary: Vec2) -> SurfaceInteraction {
         match prim {
             Prim::Triangle { mesh, tri } => {
-                let m = &self.meshes[mesh as usize];
-                let [p0, p1, p2] = m.vertices(tri);
-                let b0 = 1.0 - bary.x - bary.y;
-                // Barycentric interpolation is more accurate than o + t·d.
-                let p = p0 * b0 + p1 * bary.x + p2 * bary.y;
-                let ng = m.geometric_normal(tri);
-                let [a, b, c] = m.indices[tri as usize].map(|i| i as usize);
-                let mut ns = ng;
-                if !m.normals.is_empty() {
-                    let n = (m.normals[a] * b0 + m.normals[b] * bary.x + m.normals[c] * bary.y)
-                        .normalize_or_zero();
-                    if n != Vec3::ZERO {
-                        ns = if m.flip_normals { -n } else { n };
-                    }
-                }
-                let uv = m.uv_at(tri, bary);
-                let light = m.lights.get(tri as usize).copied();
-                let (dpdu, bitangent_sign) = if !m.tangents.is_empty() {
-                    let t = m.tangents[a] * b0 + m.tangents[b] * bary.x + m.tangents[c] * bary.y;
-                    (t.truncate(), if t.w < 0.0 { -1.0 } else { 1.0 })
-                } else if m.uvs.is_empty() {
-                    (p1 - p0, 1.0)
-                } else {
-                    let (dpdu, dpdv) =
-                        triangle_dpdu_dpdv([p0, p1, p2], [m.uvs[a], m.uvs[b], m.uvs[c]]);
-                    // Mirrored uvs: +v lies against ng × ∂p/∂u.
-                    let sign = if ng.cross(dpdu).dot(dpdv) < 0.0 {
-                        -1.0
-                    } else {
-                        1.0
-                    };
-                    (dpdu, sign)
-                };
-                let color = if m.colors.is_empty() {
-                    Vec3::ONE
-                } else {
-                    m.colors[a] * b0 + m.colors[b] * bary.x + m.colors[c] * bary.y
-                };
-                SurfaceInteraction {
-                    p,
-                    t,
-                    ng,
-                    ns,
-                    uv,
-                    dpdu,
-                    bitangent_sign,
-                    color,
-                    material: m.material,
-                    light,
-                }
+                triangle_interaction(&self.meshes[mesh as usize], None, tri, t, bary)
             }
             Prim::Sphere(i) => {
                 let s = &self.spheres[i as usize];
@@ -295,6 +286,78 @@ impl Scene {
                 }
             }
         }
+    }
+}
+
+/// The hit record of triangle `tri` of `m` at barycentrics `bary`: a world-space mesh's
+/// where `inst` is `None`, else an instance's, whose object-space vertex data is carried to
+/// world space first by the same [`crate::instance::Transform`] that flattens meshes.
+fn triangle_interaction(
+    m: &Mesh,
+    inst: Option<&Instance>,
+    tri: u32,
+    t: f32,
+    bary: Vec2,
+) -> SurfaceInteraction {
+    let xf = inst.map(|i| &i.transform);
+    let normal = |i: usize| xf.map_or(m.normals[i], |x| x.normal(m.normals[i]));
+    let flip_normals = inst.map_or(m.flip_normals, |i| i.flip_normals);
+    let material = inst.map_or(m.material, |i| i.material);
+    let tangent = |i: usize| xf.map_or(m.tangents[i], |x| x.tangent(m.tangents[i]));
+    let [a, b, c] = m.indices[tri as usize].map(|i| i as usize);
+    let [p0, p1, p2] = match xf {
+        None => m.vertices(tri),
+        Some(x) => m.vertices(tri).map(|p| x.point(p)),
+    };
+    let normals = (!m.normals.is_empty()).then(|| [normal(a), normal(b), normal(c)]);
+    let b0 = 1.0 - bary.x - bary.y;
+    // Barycentric interpolation is more accurate than o + t·d.
+    let p = p0 * b0 + p1 * bary.x + p2 * bary.y;
+    let ng = winding_normal(
+        [p0, p1, p2],
+        normals.map(|[na, nb, nc]| na + nb + nc),
+        flip_normals,
+    );
+    let mut ns = ng;
+    if let Some([na, nb, nc]) = normals {
+        let n = (na * b0 + nb * bary.x + nc * bary.y).normalize_or_zero();
+        if n != Vec3::ZERO {
+            ns = if flip_normals { -n } else { n };
+        }
+    }
+    let uv = m.uv_at(tri, bary);
+    let light = m.lights.get(tri as usize).copied();
+    let (dpdu, bitangent_sign) = if !m.tangents.is_empty() {
+        let t = tangent(a) * b0 + tangent(b) * bary.x + tangent(c) * bary.y;
+        (t.truncate(), if t.w < 0.0 { -1.0 } else { 1.0 })
+    } else if m.uvs.is_empty() {
+        (p1 - p0, 1.0)
+    } else {
+        let (dpdu, dpdv) = triangle_dpdu_dpdv([p0, p1, p2], [m.uvs[a], m.uvs[b], m.uvs[c]]);
+        // Mirrored uvs: +v lies against ng × ∂p/∂u.
+        let sign = if ng.cross(dpdu).dot(dpdv) < 0.0 {
+            -1.0
+        } else {
+            1.0
+        };
+        (dpdu, sign)
+    };
+    let color = if m.colors.is_empty() {
+        Vec3::ONE
+    } else {
+        m.colors[a] * b0 + m.colors[b] * bary.x + m.colors[c] * bary.y
+    };
+    SurfaceInteraction {
+        p,
+        t,
+        ng,
+        ns,
+        uv,
+        dpdu,
+        bitangent_sign,
+        color,
+        material,
+        light,
     }
 }
 

@@ -48,6 +48,7 @@ pub fn parse_toml_scene_with_warnings(
     let base = file.parent().unwrap_or(Path::new(""));
     let mut desc = SceneDesc::default();
     let mut included_materials = Vec::new();
+    let mut mesh_files = Default::default();
     for (key, value) in root.into_inner() {
         let key_at = key.span().start;
         match key.get_ref().as_ref() {
@@ -56,15 +57,17 @@ pub fn parse_toml_scene_with_warnings(
             "materials" => desc.materials = parse_materials(&src, base, value)?,
             "shape" => {
                 for item in array_of_tables(&src, "shape", value)? {
-                    let (shape, profile) = parse_shape(&src, base, item)?;
-                    if let Some((table, span)) = profile {
-                        desc.emission_profiles.push(EmissionProfileDesc {
-                            shape: desc.shapes.len(),
-                            table,
-                            span,
-                        });
+                    let (shapes, profile) = parse_shape(&src, base, item, &mut mesh_files)?;
+                    for shape in shapes {
+                        if let Some((table, span)) = &profile {
+                            desc.emission_profiles.push(EmissionProfileDesc {
+                                shape: desc.shapes.len(),
+                                table: table.clone(),
+                                span: span.clone(),
+                            });
+                        }
+                        desc.shapes.push(shape);
                     }
-                    desc.shapes.push(shape);
                 }
             }
             "environment" => desc.environment = Some(parse_environment(&src, base, key_at, value)?),

@@ -1,7 +1,7 @@
 //! `[[shape]]` entries of the TOML scene format and their `transform` lists.
 
-use std::path::Path;
-
+use std::collections::HashMap;
+use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
 use candela_core::desc::{GeometryDesc, MeshDesc, ShapeDesc, Span};
@@ -115,6 +115,8 @@ struct MeshEntry {
     ies: Option<Spanned<String>>,
     flip_normals: Option<bool>,
     transform: Option<Vec<Spanned<TransformOp>>>,
+    /// Placements of the one mesh: each a transform list applied after `transform`.
+    instances: Option<Spanned<Vec<Vec<Spanned<TransformOp>>>>>,
 }
 
 #[derive(Deserialize)]
@@ -149,16 +151,22 @@ const SHAPE_TYPES: &[&str] = &["mesh", "sphere", "rectangle", "disk", "cube"];
 /// An IES profile attached to an emitting shape, and where it was named.
 pub(crate) type ShapeProfile = (Arc<GoniometricTable>, Span);
 
+/// Meshes loaded from files so far, by path: `[[shape]]` entries naming the same file
+/// share one `Arc`, which the build instances.
+pub(crate) type MeshFiles = HashMap<PathBuf, Arc<MeshDesc>>;
+
 /// Parses one `[[shape]]` entry and its IES profile, if any; files resolve against
-/// `base`.
+/// `base`. A mesh with `instances` gives one shape per instance, all holding one mesh.
 pub(crate) fn parse_shape(
     src: &Source,
     base: &Path,
     item: Item,
-) -> Result<(ShapeDesc, Option<ShapeProfile>), LoadError> {
+    files: &mut MeshFiles,
+) -> Result<(Vec<ShapeDesc>, Option<ShapeProfile>), LoadError> {
     let at = item.span().start;
     let kind = item_type(src, "shape", &item, SHAPE_TYPES)?;
     check_transform_steps(src, &item)?;
+    let mut instances = None;
     let (geometry, common) = match kind {
         "mesh" => {
             let e: MeshEntry = deserialize(src, item)?;
@@ -169,9 +177,15 @@ pub(crate) fn parse_shape(
                 flip_normals: e.flip_normals,
                 transform: e.transform,
             };
+            if let Some(list) = e.instances {
+                if list.get_ref().is_empty() {
+                    return Err(src.error(list.span().start, "`instances` is empty"));
+                }
+                instances = Some(list.into_inner());
+            }
             let mesh = match (e.file, e.positions, e.indices) {
                 (Some(file), None, None) if e.normals.is_none() && e.uvs.is_none() => {
-                    mesh_file(src, base, file)?
+                    mesh_file(src, base, file, files)?
                 }
                 (Some(file), ..) => {
                     return Err(src.error(
@@ -181,7 +195,7 @@ pub(crate) fn parse_shape(
                     ))
                 }
                 (None, Some(positions), Some(indices)) => {
-                    inline_mesh(src, positions, indices, e.normals, e.uvs)?
+                    Arc::new(inline_mesh(src, positions, indices, e.normals, e.uvs)?)
                 }
                 _ => {
                     return Err(src.error(
@@ -190,7 +204,7 @@ pub(crate) fn parse_shape(
                     ))
                 }
             };
-            (GeometryDesc::Mesh(Arc::new(mesh)), common)
+            (GeometryDesc::Mesh(mesh), common)
         }
         "sphere" => {
             let e: SphereEntry = deserialize(src, item)?;
@@ -248,7 +262,19 @@ pub(crate) fn parse_shape(
         flip_normals: common.flip_normals.unwrap_or(false),
         span: src.span(at),
     };
-    Ok((shape, profile))
+    let Some(instances) = instances else {
+        return Ok((vec![shape], profile));
+    };
+    let shapes = instances
+        .into_iter()
+        .map(|steps| {
+            Ok(ShapeDesc {
+                transform: compose(src, steps)? * shape.transform,
+                ..shape.clone()
+            })
+        })
+        .collect::<Result<_, LoadError>>()?;
+    Ok((shapes, profile))
 }
 
 /// Gives a step with several keys a clearer error than serde's enum message.
@@ -275,13 +301,24 @@ pub(crate) fn check_transform_steps(src: &Source, item: &Item) -> Result<(), Loa
     Ok(())
 }
 
-fn mesh_file(src: &Source, base: &Path, file: Spanned<String>) -> Result<MeshDesc, LoadError> {
+fn mesh_file(
+    src: &Source,
+    base: &Path,
+    file: Spanned<String>,
+    files: &mut MeshFiles,
+) -> Result<Arc<MeshDesc>, LoadError> {
     let at = file.span().start;
     let path = base.join(file.get_ref());
     if !path.is_file() {
         return Err(src.error(at, format!("mesh file {} does not exist", path.display())));
     }
-    load_mesh(&path).map_err(|e| src.error(at, e.to_string()))
+    let key = std::fs::canonicalize(&path).unwrap_or(path);
+    if let Some(m) = files.get(&key) {
+        return Ok(m.clone());
+    }
+    let mesh = Arc::new(load_mesh(&key).map_err(|e| src.error(at, e.to_string()))?);
+    files.insert(key, mesh.clone());
+    Ok(mesh)
 }
 
 fn inline_mesh(

@@ -15,8 +15,9 @@ mod transform;
 
 use std::collections::HashMap;
 use std::path::Path;
+use std::sync::Arc;
 
-use candela_core::desc::{SceneDesc, TextureDesc};
+use candela_core::desc::{MeshDesc, SceneDesc, ShapeDesc, TextureDesc};
 use glam::Vec3;
 
 use crate::{LoadError, LoadOptions, LoadedScene};
@@ -49,6 +50,8 @@ fn map_scene(root: Node, path: &Path, options: &LoadOptions) -> Result<LoadedSce
         warnings: Vec::new(),
         bsdf_ids: HashMap::new(),
         texture_ids: HashMap::new(),
+        shape_groups: HashMap::new(),
+        mesh_files: HashMap::new(),
         desc: SceneDesc::default(),
     };
     // Mitsuba's default integrator is `path` with unlimited depth.
@@ -72,6 +75,14 @@ fn map_scene(root: Node, path: &Path, options: &LoadOptions) -> Result<LoadedSce
         if let Some(id) = c.attr("id") {
             ctx.bsdf_ids.insert(id.to_string(), name);
         }
+    }
+    // Shape groups next, so that instances may come before or after their group.
+    for c in root
+        .children
+        .iter()
+        .filter(|c| c.tag == "shape" && c.kind() == "shapegroup")
+    {
+        shapes::shape_group(&mut ctx, c)?;
     }
     for c in &root.children {
         match c.tag.as_str() {
@@ -100,6 +111,10 @@ pub(crate) struct Ctx {
     pub bsdf_ids: HashMap<String, String>,
     /// Each top-level texture by its `id`.
     pub texture_ids: HashMap<String, TextureDesc>,
+    /// The shapes of each `shapegroup` by its `id`, in the group's object space.
+    pub shape_groups: HashMap<String, Vec<ShapeDesc>>,
+    /// Meshes loaded so far, by (file, face_normals, flip_tex_coords).
+    pub mesh_files: HashMap<(std::path::PathBuf, bool, bool), Arc<MeshDesc>>,
     pub desc: SceneDesc,
 }
 

@@ -12,7 +12,88 @@ use super::parse::Node;
 use super::{bsdfs, describe, transform, Ctx};
 use crate::LoadError;
 
+/// A top-level `<shape>`: one shape, an `instance` of a `shapegroup`, or (a
+/// `shapegroup` itself) nothing until an instance places it.
 pub(crate) fn shape(ctx: &mut Ctx, node: &Node) -> Result<(), LoadError> {
+    match node.kind() {
+        "shapegroup" => Ok(()),
+        "instance" => instance(ctx, node),
+        _ => {
+            if let Some(s) = shape_desc(ctx, node)? {
+                ctx.desc.shapes.push(s);
+            }
+            Ok(())
+        }
+    }
+}
+
+/// A `<shape type="shapegroup" id="…">`: its shapes, kept under the id for instances.
+/// Mitsuba 3 allows no emitters and no nested groups inside a group.
+pub(crate) fn shape_group(ctx: &mut Ctx, node: &Node) -> Result<(), LoadError> {
+    let id = node.req("id")?;
+    let mut shapes = Vec::new();
+    for c in node.plugins("shape") {
+        if matches!(c.kind(), "shapegroup" | "instance") {
+            return Err(c.error(format!("a shapegroup cannot hold a {}", describe(c))));
+        }
+        if let Some(e) = c.children.iter().find(|e| e.tag == "emitter") {
+            return Err(e.error(
+                "a shape in a shapegroup cannot emit (Mitsuba 3 allows no emitters in groups)",
+            ));
+        }
+        if let Some(s) = shape_desc(ctx, c)? {
+            shapes.push(s);
+        }
+    }
+    ctx.check_unused(node)?;
+    if ctx.shape_groups.insert(id.to_string(), shapes).is_some() {
+        return Err(node.error(format!("id \"{id}\" is used twice")));
+    }
+    Ok(())
+}
+
+/// A `<shape type="instance">`: the group of its `<ref id>`, each shape's transform
+/// preceded by the instance's `to_world`. Meshes keep their `Arc`s, so the build stores
+/// them once (see `candela_core::instance`).
+fn instance(ctx: &mut Ctx, node: &Node) -> Result<(), LoadError> {
+    let mut refs = node.children.iter().filter(|c| c.tag == "ref");
+    let Some(r) = refs.next() else {
+        return Err(node.error("an instance needs a <ref id> to a shapegroup"));
+    };
+    if let Some(extra) = refs.next() {
+        return Err(extra.error("an instance refers to exactly one shapegroup"));
+    }
+    r.used.set(true);
+    let id = r.req("id")?;
+    let Some(group) = ctx.shape_groups.get(id) else {
+        return Err(r.error(format!(
+            "no <shape type=\"shapegroup\"> has the id \"{id}\""
+        )));
+    };
+    let to_world = to_world(node)?;
+    let placed: Vec<ShapeDesc> = group
+        .iter()
+        .map(|s| ShapeDesc {
+            transform: to_world * s.transform,
+            span: node.span.clone(),
+            ..s.clone()
+        })
+        .collect();
+    ctx.check_unused(node)?;
+    ctx.desc.shapes.extend(placed);
+    Ok(())
+}
+
+fn to_world(node: &Node) -> Result<Mat4, LoadError> {
+    match node.prop("to_world") {
+        Some(t) if t.tag == "transform" => transform::transform(t),
+        Some(t) => Err(t.error("to_world must be a <transform>")),
+        None => Ok(Mat4::IDENTITY),
+    }
+}
+
+/// The description of one shape; `None` where `--lenient` skips it.
+fn shape_desc(ctx: &mut Ctx, node: &Node) -> Result<Option<ShapeDesc>, LoadError> {
     let geometry = match node.kind() {
         "rectangle" => GeometryDesc::Rectangle,
         "disk" => GeometryDesc::Disk,
@@ -25,30 +106,40 @@ pub(crate) fn shape(ctx: &mut Ctx, node: &Node) -> Result<(), LoadError> {
             let file = node
                 .string("filename")?
                 .ok_or_else(|| node.error(format!("{} needs a filename", describe(node))))?;
-            let mut mesh = crate::load_mesh(&ctx.base.join(file))
-                .map_err(|e| node.error(format!("cannot load mesh: {e}")))?;
-            if node.boolean("face_normals")?.unwrap_or(false) {
-                mesh.normals.clear();
-            }
+            let path = ctx.base.join(file);
+            let face_normals = node.boolean("face_normals")?.unwrap_or(false);
             // Mitsuba flips OBJ texture coordinates by default; no Candela texture reads
             // them yet, so the flag is read and only honoured on the uvs.
-            if node
+            let flip_uv = node
                 .boolean("flip_tex_coords")?
-                .unwrap_or(node.kind() == "obj")
-            {
-                mesh.uvs.iter_mut().for_each(|uv| uv.y = 1.0 - uv.y);
-            }
-            GeometryDesc::Mesh(Arc::new(mesh))
+                .unwrap_or(node.kind() == "obj");
+            // Shapes loading the same file the same way share one mesh, which the build
+            // then instances.
+            let key = (path, face_normals, flip_uv);
+            let mesh = match ctx.mesh_files.get(&key) {
+                Some(m) => m.clone(),
+                None => {
+                    let mut mesh = crate::load_mesh(&key.0)
+                        .map_err(|e| node.error(format!("cannot load mesh: {e}")))?;
+                    if face_normals {
+                        mesh.normals.clear();
+                    }
+                    if flip_uv {
+                        mesh.uvs.iter_mut().for_each(|uv| uv.y = 1.0 - uv.y);
+                    }
+                    let mesh = Arc::new(mesh);
+                    ctx.mesh_files.insert(key, mesh.clone());
+                    mesh
+                }
+            };
+            GeometryDesc::Mesh(mesh)
         }
         _ => {
-            return ctx.unsupported(node, format!("<{}> is not supported", describe(node)));
+            ctx.unsupported(node, format!("<{}> is not supported", describe(node)))?;
+            return Ok(None);
         }
     };
-    let transform = match node.prop("to_world") {
-        Some(t) if t.tag == "transform" => transform::transform(t)?,
-        Some(t) => return Err(t.error("to_world must be a <transform>")),
-        None => Mat4::IDENTITY,
-    };
+    let transform = to_world(node)?;
     let flip_normals = node.boolean("flip_normals")?.unwrap_or(false);
     let material = material(ctx, node)?;
     let geometry = match geometry {
@@ -74,15 +165,14 @@ pub(crate) fn shape(ctx: &mut Ctx, node: &Node) -> Result<(), LoadError> {
         ctx.check_unused(e)?;
     }
     ctx.check_unused(node)?;
-    ctx.desc.shapes.push(ShapeDesc {
+    Ok(Some(ShapeDesc {
         geometry,
         material,
         emission,
         transform,
         flip_normals,
         span: node.span.clone(),
-    });
-    Ok(())
+    }))
 }
 
 /// The shape's material: an inline `<bsdf>`, a `<ref id>` to one, or Mitsuba's default
