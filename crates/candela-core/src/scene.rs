@@ -60,7 +60,12 @@ impl Mesh {
     /// normals where the mesh has them, and flipped by `flip_normals`. Zero for a
     /// degenerate triangle.
     pub fn geometric_normal(&self, tri: u32) -> Vec3 {
-        let [p0, p1, p2] = self.vertices(tri);
+        self.geometric_normal_of(tri, self.vertices(tri))
+    }
+
+    /// [`Self::geometric_normal`] of triangle `tri` whose vertices are `[p0, p1, p2]`.
+    #[inline]
+    fn geometric_normal_of(&self, tri: u32, [p0, p1, p2]: [Vec3; 3]) -> Vec3 {
         let mut n = (p1 - p0).cross(p2 - p0).normalize_or_zero();
         if !self.normals.is_empty() {
             let [a, b, c] = self.indices[tri as usize];
@@ -199,7 +204,7 @@ impl Scene {
             return dist == 0.0;
         }
         // A relative margin keeps the far end from blocking itself.
-        !self.occluded(&Ray::new(o, d / dist), dist * (1.0 - 1e-4))
+        !self.occluded(&Ray::new(o, d * (1.0 / dist)), dist * (1.0 - 1e-4))
     }
 
     /// Whether a ray leaving `from` towards `d` escapes the scene.
@@ -223,7 +228,7 @@ impl Scene {
                 let b0 = 1.0 - bary.x - bary.y;
                 // Barycentric interpolation is more accurate than o + t·d.
                 let p = p0 * b0 + p1 * bary.x + p2 * bary.y;
-                let ng = m.geometric_normal(tri);
+                let ng = m.geometric_normal_of(tri, [p0, p1, p2]);
                 let [a, b, c] = m.indices[tri as usize].map(|i| i as usize);
                 let mut ns = ng;
                 if !m.normals.is_empty() {

@@ -93,7 +93,7 @@ impl ParallelogramLight {
             return None;
         }
         let distance = d2.sqrt();
-        let wi = to / distance;
+        let wi = to * (1.0 / distance);
         let cos_l = -wi.dot(self.n);
         if cos_l <= 0.0 {
             return None;
