@@ -32,9 +32,10 @@ pub fn run(path: &Path, load: &LoadArgs) -> Result<(), UserError> {
         );
     }
     println!(
-        "lights     {} ({} emitting triangles, {} spheres, {} points, {} environments), total power {:.4} W",
+        "lights     {} ({} emitting triangles, {} emitting quads, {} spheres, {} points, {} environments), total power {:.4} W",
         scene.lights.len(),
         count(|l| matches!(l, Light::Triangle(_))),
+        count(|l| matches!(l, Light::Parallelogram(_))),
         count(|l| matches!(l, Light::Sphere(_))),
         count(|l| matches!(l, Light::Point(_))),
         count(|l| matches!(l, Light::Environment(_))),

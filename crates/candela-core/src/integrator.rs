@@ -229,24 +229,41 @@ pub fn li<S: Sampler>(scene: &Scene, mut ray: Ray, sampler: &mut S, rays: &mut u
 
         let bsdf = scene.materials[si.material.0 as usize].bsdf_at(&si);
         let ctx = ShadingCtx { p: si.p, n: si.ns };
-        let (u_light, u_point) = (sampler.get_1d(), sampler.get_2d());
+        // A number nothing reads is skipped, not computed (its dimension stays taken):
+        // the light pick where there is one light, the lobe choice of one-lobe BSDFs, and
+        // Russian roulette before it starts.
+        let u_light = if scene.lights.len() > 1 {
+            sampler.get_1d()
+        } else {
+            sampler.skip_1d();
+            0.5
+        };
+        let u_point = sampler.get_2d();
         if !bsdf.is_delta() {
             l += beta * sample_direct(scene, &si, &ctx, &bsdf, wo, u_light, u_point, rays);
         }
 
-        let (u_lobe, u_dir) = (sampler.get_1d(), sampler.get_2d());
+        let u_lobe = if bsdf.lobe.takes_lobe_sample() {
+            sampler.get_1d()
+        } else {
+            sampler.skip_1d();
+            0.5
+        };
+        let u_dir = sampler.get_2d();
         let Some(bs) = bsdf.sample(wo, u_lobe, u_dir) else {
             break;
         };
-        beta *= bs.f * bsdf.abs_cos(bs.wi) / bs.pdf;
+        beta *= bs.f * (bsdf.abs_cos(bs.wi) / bs.pdf);
         specular = bs.flags.is_delta();
         prev_bsdf_pdf = bs.pdf;
         prev_ctx = ctx;
         ray = si.spawn_ray(bs.wi);
         depth += 1;
 
-        let u_rr = sampler.get_1d();
-        if depth >= RR_MIN_DEPTH {
+        if depth < RR_MIN_DEPTH {
+            sampler.skip_1d();
+        } else {
+            let u_rr = sampler.get_1d();
             // Survival in proportion to the throughput, so survivors carry weight ~1.
             // No cap below 1 (Mitsuba caps at 0.95): in a white furnace a cap makes the
             // weights grow by 1/0.95 per bounce and the variance unbounded.
@@ -254,7 +271,7 @@ pub fn li<S: Sampler>(scene: &Scene, mut ray: Ray, sampler: &mut S, rays: &mut u
             if u_rr < q {
                 break;
             }
-            beta /= 1.0 - q;
+            beta *= 1.0 / (1.0 - q);
         }
         if beta == Vec3::ZERO || !beta.is_finite() {
             break;
@@ -289,7 +306,7 @@ fn sample_direct(
     let Some(ls) = light.sample_li(ctx, u_point) else {
         return Vec3::ZERO;
     };
-    let f = bsdf.f(wo, ls.wi) * bsdf.abs_cos(ls.wi);
+    let (f, bsdf_pdf) = bsdf.f_cos_pdf(wo, ls.wi);
     if f == Vec3::ZERO {
         return Vec3::ZERO;
     }
@@ -309,7 +326,7 @@ fn sample_direct(
     let weight = match mode {
         _ if ls.is_delta => 1.0,
         MisMode::NeeOnly => 1.0,
-        _ => mis_weight(mode, pick.mis_pmf * ls.pdf, bsdf.pdf(wo, ls.wi)),
+        _ => mis_weight(mode, pick.mis_pmf * ls.pdf, bsdf_pdf),
     };
-    f * ls.radiance * weight / (pick.pmf * ls.pdf)
+    f * ls.radiance * (weight / (pick.pmf * ls.pdf))
 }

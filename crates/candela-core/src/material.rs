@@ -82,6 +82,9 @@ impl Material {
                 one_sided: true,
                 ..inner.bsdf_at(si)
             },
+            // A Lambertian lobe looks the same in every frame around ns, so it skips
+            // orthogonalizing the tangent (a square root and a division per hit).
+            Material::Diffuse { .. } => Bsdf::new(si.ns, si.ng, self.lobe(si.uv, si.color)),
             _ => Bsdf::with_tangent(si.ns, si.ng, si.dpdu, self.lobe(si.uv, si.color)),
         }
     }

@@ -39,13 +39,19 @@ pub fn luminance(c: Vec3) -> f32 {
 /// Offsets a ray origin `p` off a surface with geometric normal `n`, towards the side of
 /// `n`, by an amount that scales with the magnitude of `p`'s coordinates. Wächter and
 /// Binder, "A Fast and Robust Method for Avoiding Self-Intersection", Ray Tracing Gems
-/// ch. 6: integer ulp steps far from the origin, a small float step near it.
+/// ch. 6: integer ulp steps far from the origin, a small float step near it. `n` is a unit
+/// vector (each |n_i| ≤ 1).
 pub fn offset_ray_origin(p: Vec3, n: Vec3) -> Vec3 {
     const ORIGIN: f32 = 1.0 / 32.0;
     const FLOAT_SCALE: f32 = 1.0 / 65536.0;
     const INT_SCALE: f32 = 256.0;
+    // 1.5·2²³: adding it to |x| < 2²² leaves round(x) in the low mantissa bits, so the
+    // integer step costs an add and a subtract instead of `as i32`'s saturating
+    // conversion (a third of this function's instructions in callgrind). Rounding
+    // instead of the paper's truncation changes a step by at most one ulp.
+    const ROUND: f32 = 12_582_912.0;
     let offset = |p: f32, n: f32| -> f32 {
-        let of_i = (INT_SCALE * n) as i32;
+        let of_i = (INT_SCALE * n + ROUND).to_bits() as i32 - ROUND.to_bits() as i32;
         let bits = p.to_bits() as i32;
         let stepped = f32::from_bits((bits + if p < 0.0 { -of_i } else { of_i }) as u32);
         if p.abs() < ORIGIN {
@@ -98,6 +104,25 @@ mod tests {
             assert!((f.s.cross(f.t) - n).length() < 1e-5, "right-handed");
             let v = Vec3::new(0.2, 0.5, -0.7);
             assert!((f.to_world(f.to_local(v)) - v).length() < 1e-5);
+        }
+    }
+
+    #[test]
+    fn offset_steps_are_the_rounded_scaled_normal() {
+        // Far from the origin the step is round(256·n) ulps, on the side of n.
+        let p = Vec3::new(3.0, -5.0, 1000.0);
+        for n in [
+            Vec3::X,
+            -Vec3::Y,
+            Vec3::new(0.6, 0.0, -0.8),
+            Vec3::new(0.001, 0.7, 0.714),
+        ] {
+            let q = offset_ray_origin(p, n);
+            for i in 0..3 {
+                let steps = q[i].to_bits() as i64 - p[i].to_bits() as i64;
+                let want = (256.0 * n[i]).round() as i64 * p[i].signum() as i64;
+                assert_eq!(steps, want, "n = {n}, axis {i}");
+            }
         }
     }
 

@@ -5,7 +5,7 @@
 //! (solid angle for directions, area for points). Each warp is checked by the chi-square
 //! suite in `tests/chi2_sampling.rs`.
 
-use std::f32::consts::{FRAC_PI_2, FRAC_PI_4, PI};
+use std::f32::consts::{FRAC_1_PI, FRAC_PI_4, PI};
 
 use glam::{Vec2, Vec3};
 
@@ -16,12 +16,29 @@ pub fn sample_concentric_disk(u: Vec2) -> Vec2 {
     if o == Vec2::ZERO {
         return Vec2::ZERO;
     }
-    let (r, theta) = if o.x.abs() > o.y.abs() {
-        (o.x, FRAC_PI_4 * (o.y / o.x))
+    // θ = a or π/2 − a with |a| ≤ π/4, so (cos θ, sin θ) is (cos a, sin a) or
+    // (sin a, cos a): two short polynomials instead of a call to the library's sincos.
+    if o.x.abs() > o.y.abs() {
+        let (s, c) = sin_cos_quarter(FRAC_PI_4 * (o.y / o.x));
+        o.x * Vec2::new(c, s)
     } else {
-        (o.y, FRAC_PI_2 - FRAC_PI_4 * (o.x / o.y))
-    };
-    r * Vec2::new(theta.cos(), theta.sin())
+        let (s, c) = sin_cos_quarter(FRAC_PI_4 * (o.x / o.y));
+        o.y * Vec2::new(s, c)
+    }
+}
+
+/// (sin a, cos a) for |a| ≤ π/4, by their Taylor polynomials to degree 9 and 8: the
+/// first omitted terms, a¹¹/11! and a¹⁰/10!, are below 1.8·10⁻⁹ and 2.5·10⁻⁸ there, under
+/// half an f32 ulp of the result.
+#[inline]
+pub fn sin_cos_quarter(a: f32) -> (f32, f32) {
+    let a2 = a * a;
+    let s = a
+        * (1.0
+            + a2 * (-1.0 / 6.0
+                + a2 * (1.0 / 120.0 + a2 * (-1.0 / 5040.0 + a2 * (1.0 / 362_880.0)))));
+    let c = 1.0 + a2 * (-0.5 + a2 * (1.0 / 24.0 + a2 * (-1.0 / 720.0 + a2 * (1.0 / 40_320.0))));
+    (s, c)
 }
 
 /// Cosine-weighted direction on the hemisphere around +z (Malley's method).
@@ -33,7 +50,7 @@ pub fn sample_cosine_hemisphere(u: Vec2) -> Vec3 {
 
 /// Density of [`sample_cosine_hemisphere`] in solid angle.
 pub fn cosine_hemisphere_pdf(cos_theta: f32) -> f32 {
-    cos_theta.max(0.0) / PI
+    cos_theta.max(0.0) * FRAC_1_PI
 }
 
 /// Uniform direction on the unit sphere.
@@ -274,6 +291,37 @@ impl Distribution1D {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn sin_cos_quarter_matches_the_library_to_an_ulp() {
+        // Over |a| ≤ π/4 at 10⁵ + 1 points, ends included, against f64's sin and cos.
+        let mut worst = 0.0f64;
+        for i in 0..=100_000 {
+            let a = FRAC_PI_4 * (i as f32 / 50_000.0 - 1.0);
+            let (s, c) = sin_cos_quarter(a);
+            let (ws, wc) = (a as f64).sin_cos();
+            worst = worst.max((s as f64 - ws).abs()).max((c as f64 - wc).abs());
+        }
+        // One f32 ulp of values in [0.7, 1] is 6·10⁻⁸ (the Taylor remainder is below it).
+        assert!(worst < 1.2e-7, "worst error {worst:e}");
+    }
+
+    #[test]
+    fn concentric_disk_keeps_the_square_s_edges_on_the_circle() {
+        for i in 0..=64 {
+            let t = i as f32 / 64.0;
+            for u in [
+                Vec2::new(t, 0.0),
+                Vec2::new(t, 1.0),
+                Vec2::new(0.0, t),
+                Vec2::new(1.0, t),
+            ] {
+                let d = sample_concentric_disk(u);
+                assert!((d.length() - 1.0).abs() < 2e-7, "{u} -> {d}");
+            }
+        }
+        assert_eq!(sample_concentric_disk(Vec2::splat(0.5)), Vec2::ZERO);
+    }
 
     #[test]
     fn alias_table_pmf_matches_weights_and_sums_to_one() {

@@ -239,7 +239,7 @@ impl Scene {
             return dist == 0.0;
         }
         // A relative margin keeps the far end from blocking itself.
-        !self.occluded(&Ray::new(o, d / dist), dist * (1.0 - 1e-4))
+        !self.occluded(&Ray::new(o, d * (1.0 / dist)), dist * (1.0 - 1e-4))
     }
 
     /// Whether a ray leaving `from` towards `d` escapes the scene.

@@ -8,6 +8,7 @@ use candela_core::desc::{
     BsdfDesc, GeometryDesc, LightKindDesc, LightSamplerKind, MisMode, SamplerKind, SceneDesc, Span,
     TextureDesc,
 };
+use candela_core::light::Light;
 use candela_scene::{load_scene, parse_toml_scene};
 use glam::{Mat4, Vec3};
 
@@ -236,7 +237,9 @@ fn inline_and_file_meshes() {
     assert_eq!(desc.shapes[1].span, Span::new(file.as_str(), 9, 1));
 
     let built = candela_core::build::build(&desc).unwrap();
-    assert_eq!(built.lights.len(), 2, "the quad's two triangles emit");
+    // The quad's two triangles emit, as one parallelogram light.
+    assert_eq!(built.lights.len(), 1);
+    assert!(matches!(built.lights[0], Light::Parallelogram(_)));
 }
 
 #[test]
@@ -258,5 +261,6 @@ fn cornell_box() {
     let emitting: usize = scene.meshes.iter().map(|m| m.lights.len()).sum();
     assert_eq!(triangles, 32);
     assert_eq!(emitting, 2);
-    assert_eq!(scene.lights.len(), 2);
+    // The lamp's two triangles are one parallelogram light.
+    assert_eq!(scene.lights.len(), 1);
 }

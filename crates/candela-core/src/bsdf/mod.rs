@@ -154,6 +154,12 @@ impl Lobe {
         })
     }
 
+    /// Whether [`Self::sample`] reads `u_lobe` (the lambertian and conductor lobes have
+    /// one component and ignore it).
+    pub fn takes_lobe_sample(&self) -> bool {
+        !matches!(self, Lobe::Diffuse(_) | Lobe::Conductor(_))
+    }
+
     fn is_reflective(&self) -> bool {
         !matches!(self, Lobe::Dielectric(_) | Lobe::ThinDielectric(_))
     }
@@ -242,6 +248,16 @@ impl Bsdf {
         self.lobe.pdf(lo, li)
     }
 
+    /// [`Self::f`] times |cos θᵢ|, and [`Self::pdf`], of one pair of directions: what next
+    /// event estimation asks for, with one change of frame instead of three.
+    pub fn f_cos_pdf(&self, wo: Vec3, wi: Vec3) -> (Vec3, f32) {
+        let (lo, li) = (self.frame.to_local(wo), self.frame.to_local(wi));
+        if self.blind(lo) || !self.sides_agree(wo, wi, lo, li) {
+            return (Vec3::ZERO, 0.0);
+        }
+        (self.lobe.f(lo, li) * li.z.abs(), self.lobe.pdf(lo, li))
+    }
+
     pub fn sample(&self, wo: Vec3, u_lobe: f32, u: Vec2) -> Option<BsdfSample> {
         let lo = self.frame.to_local(wo);
         if self.blind(lo) {
@@ -265,5 +281,39 @@ impl Bsdf {
     /// |cos θ| of `wi` against the shading normal.
     pub fn abs_cos(&self, wi: Vec3) -> f32 {
         wi.dot(self.frame.n).abs()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn f_cos_pdf_is_f_times_cos_and_pdf() {
+        let ns = Vec3::new(0.2, 0.3, 0.9).normalize();
+        let ng = Vec3::new(0.0, 0.2, 1.0).normalize();
+        let lobes = [
+            Lobe::Diffuse(Diffuse {
+                albedo: Vec3::new(0.7, 0.5, 0.2),
+            }),
+            Lobe::MetalRough(MetalRough::new(Vec3::new(0.9, 0.6, 0.3), 0.5, 0.4)),
+        ];
+        let dirs = [
+            Vec3::new(0.3, -0.2, 0.9),
+            Vec3::new(-0.7, 0.1, 0.4),
+            Vec3::new(0.1, 0.8, -0.3),
+            Vec3::new(0.5, 0.5, 0.05),
+        ]
+        .map(Vec3::normalize);
+        for lobe in lobes {
+            let bsdf = Bsdf::with_tangent(ns, ng, Vec3::X, lobe);
+            for wo in dirs {
+                for wi in dirs {
+                    let (f, pdf) = bsdf.f_cos_pdf(wo, wi);
+                    assert_eq!(f, bsdf.f(wo, wi) * bsdf.abs_cos(wi), "{wo} {wi}");
+                    assert_eq!(pdf, bsdf.pdf(wo, wi), "{wo} {wi}");
+                }
+            }
+        }
     }
 }

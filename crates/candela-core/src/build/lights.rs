@@ -22,8 +22,8 @@ use crate::desc::{
 };
 use crate::light::blackbody::blackbody_rgb;
 use crate::light::{
-    DirectionalLight, GoniometricLight, Light, LightId, LightProfile, PointLight, ProjectorLight,
-    SpotLight, TriangleLight,
+    DirectionalLight, GoniometricLight, Light, LightId, LightProfile, ParallelogramLight,
+    PointLight, ProjectorLight, SpotLight, TriangleLight,
 };
 use crate::math::luminance;
 use crate::scene::Mesh;
@@ -283,7 +283,8 @@ pub(super) fn check_emission_profiles(desc: &SceneDesc) -> Result<(), BuildError
     Ok(())
 }
 
-/// One light per triangle of the world-space `mesh` of shape `shape_index`, emitting
+/// One light per triangle of the world-space `mesh` of shape `shape_index` (one per
+/// quad where two consecutive unshaped triangles tile a parallelogram), emitting
 /// `le`, shaped by the shape's IES profile if it has one (nadir along each triangle's
 /// normal, C0 along the shape's transformed local +x).
 pub(super) fn triangle_lights(
@@ -304,10 +305,25 @@ pub(super) fn triangle_lights(
     // (normal, profile, projected solid angle) of the last triangle: flat shapes repeat
     // them, and the projected solid angle is a quadrature worth reusing.
     let mut last: Option<(Vec3, LightProfile, f32)> = None;
-    for tri in 0..mesh.indices.len() as u32 {
+    let count = mesh.indices.len() as u32;
+    let mut tri = 0;
+    while tri < count {
         let n = mesh.geometric_normal(tri);
-        mesh.lights.push(LightId(lights.len() as u32));
         let mut light = TriangleLight::new(mesh.vertices(tri), n, le);
+        // A quad's two triangles (consecutive, as loaders triangulate quads) become one
+        // parallelogram light, whose 2D samples are stratified over the whole quad.
+        if table.is_none() && tri + 1 < count {
+            let next =
+                TriangleLight::new(mesh.vertices(tri + 1), mesh.geometric_normal(tri + 1), le);
+            if let Some(quad) = ParallelogramLight::from_triangles(&light, &next) {
+                let id = LightId(lights.len() as u32);
+                mesh.lights.extend([id, id]);
+                lights.push(Light::Parallelogram(quad));
+                tri += 2;
+                continue;
+            }
+        }
+        mesh.lights.push(LightId(lights.len() as u32));
         if let Some(table) = &table {
             if last.as_ref().is_none_or(|(ln, _, _)| *ln != n) {
                 last = LightProfile::new(table.clone(), n, c0).map(|p| {
@@ -320,5 +336,6 @@ pub(super) fn triangle_lights(
             }
         }
         lights.push(Light::Triangle(light));
+        tri += 1;
     }
 }

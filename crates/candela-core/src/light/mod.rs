@@ -17,6 +17,7 @@ mod directional;
 mod environment;
 pub mod envmap;
 mod goniometric;
+mod parallelogram;
 mod point;
 mod positional;
 mod profile;
@@ -29,6 +30,7 @@ pub use bounds::{cone_measure, cone_union, ImportanceBounds, LightBounds};
 pub use directional::DirectionalLight;
 pub use environment::{EnvironmentLight, EnvironmentMap, EnvironmentSampling};
 pub use goniometric::GoniometricLight;
+pub use parallelogram::ParallelogramLight;
 pub use point::PointLight;
 pub use profile::LightProfile;
 pub use projector::ProjectorLight;
@@ -82,6 +84,7 @@ pub struct LightSample {
 pub enum Light {
     Point(PointLight),
     Triangle(TriangleLight),
+    Parallelogram(ParallelogramLight),
     Sphere(SphereLight),
     Spot(SpotLight),
     Goniometric(GoniometricLight),
@@ -95,6 +98,7 @@ impl Light {
         let s = match self {
             Light::Point(l) => l.sample_li(ctx),
             Light::Triangle(l) => l.sample_li(ctx, u),
+            Light::Parallelogram(l) => l.sample_li(ctx, u),
             Light::Sphere(l) => l.sample_li(ctx, u),
             Light::Spot(l) => l.sample_li(ctx),
             Light::Goniometric(l) => l.sample_li(ctx),
@@ -114,6 +118,7 @@ impl Light {
             | Light::Directional(_)
             | Light::Projector(_) => 0.0,
             Light::Triangle(l) => l.pdf_li(ctx, wi),
+            Light::Parallelogram(l) => l.pdf_li(ctx, wi),
             Light::Sphere(l) => l.pdf_li(ctx, wi),
             Light::Environment(l) => l.pdf_li(ctx, wi),
         }
@@ -129,6 +134,7 @@ impl Light {
             | Light::Projector(_)
             | Light::Environment(_) => Vec3::ZERO,
             Light::Triangle(l) => l.radiance(n, w),
+            Light::Parallelogram(l) => l.radiance(n, w),
             Light::Sphere(l) => l.radiance(n, w),
         }
     }
@@ -155,6 +161,7 @@ impl Light {
         match self {
             Light::Point(l) => l.power(),
             Light::Triangle(l) => l.power(),
+            Light::Parallelogram(l) => l.power(),
             Light::Sphere(l) => l.power(),
             Light::Spot(l) => l.power(),
             Light::Goniometric(l) => l.power(),
@@ -173,6 +180,7 @@ impl Light {
         match self {
             Light::Point(l) => l.importance(ctx),
             Light::Triangle(l) => l.importance(ctx),
+            Light::Parallelogram(l) => l.importance(ctx),
             Light::Sphere(l) => l.importance(ctx),
             Light::Spot(l) => l.importance(ctx),
             Light::Goniometric(l) => l.importance(ctx),
@@ -188,6 +196,7 @@ impl Light {
         match self {
             Light::Point(l) => Some(l.bounds()),
             Light::Triangle(l) => Some(l.bounds()),
+            Light::Parallelogram(l) => Some(l.bounds()),
             Light::Sphere(l) => Some(l.bounds()),
             Light::Spot(l) => Some(l.bounds()),
             Light::Goniometric(l) => Some(l.bounds()),

@@ -69,7 +69,7 @@ impl TriangleLight {
             return None;
         }
         let distance = d2.sqrt();
-        let wi = to / distance;
+        let wi = to * (1.0 / distance);
         let cos_l = -wi.dot(self.n);
         if cos_l <= 0.0 {
             return None;

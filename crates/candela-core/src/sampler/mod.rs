@@ -23,6 +23,12 @@ pub trait Sampler: Send + Sync + Clone {
     fn start_pixel_sample(&mut self, pixel: UVec2, index: u32);
     fn get_1d(&mut self) -> f32;
     fn get_2d(&mut self) -> Vec2;
+    /// Passes over the next 1D request without computing it: the requests after it are
+    /// those that would have followed [`Self::get_1d`], so a consumer that does not need a
+    /// number (one light to pick, a one-lobe BSDF) keeps every later dimension in place.
+    fn skip_1d(&mut self) {
+        self.get_1d();
+    }
     /// The sample's position inside its pixel.
     fn get_pixel_2d(&mut self) -> Vec2 {
         self.get_2d()
@@ -62,6 +68,10 @@ impl Sampler for IndependentSampler {
     fn get_2d(&mut self) -> Vec2 {
         let x = self.rng.uniform_f32();
         Vec2::new(x, self.rng.uniform_f32())
+    }
+
+    fn skip_1d(&mut self) {
+        self.rng.next_u32();
     }
 }
 
@@ -128,6 +138,25 @@ mod tests {
         b.start_pixel_sample(UVec2::new(4, 3), 5);
         let xd: Vec<f32> = (0..8).map(|_| b.get_1d()).collect();
         assert_ne!(xa, xd);
+    }
+
+    /// After `skip_1d` every later request equals what it is after `get_1d`.
+    fn skipping_keeps_later_requests<S: Sampler>(mut a: S, mut b: S) {
+        for index in 0..4 {
+            a.start_pixel_sample(UVec2::new(5, 6), index);
+            b.start_pixel_sample(UVec2::new(5, 6), index);
+            let _ = (a.get_2d(), b.get_2d());
+            a.get_1d();
+            b.skip_1d();
+            assert_eq!(a.get_2d(), b.get_2d());
+            assert_eq!(a.get_1d(), b.get_1d());
+        }
+    }
+
+    #[test]
+    fn skipping_a_request_keeps_the_later_ones_in_place() {
+        skipping_keeps_later_requests(IndependentSampler::new(3), IndependentSampler::new(3));
+        skipping_keeps_later_requests(SobolSampler::new(3), SobolSampler::new(3));
     }
 
     #[test]

@@ -182,6 +182,11 @@ impl Sampler for SobolSampler {
     }
 
     #[inline]
+    fn skip_1d(&mut self) {
+        self.dimension += 1;
+    }
+
+    #[inline]
     fn get_2d(&mut self) -> Vec2 {
         let (i, h) = self.next_request(2);
         let x = scramble_reversed(i, (h >> 32) as u32).reverse_bits();

@@ -1,0 +1,285 @@
+use glam::{Vec2, Vec3};
+
+use super::{receiver_cos, LightBounds, LightSample, ShadingCtx, TriangleLight};
+use crate::geometry::Aabb;
+use crate::math::luminance;
+
+/// An emitting parallelogram p₀ + a·e₁ + b·e₂, (a, b) ∈ [0, 1]²: the two triangles of an
+/// emitting quad (a rectangle light, the Cornell box's lamp) made one light at build time
+/// (see [`ParallelogramLight::from_triangles`]). Emits `le` on the side its normal `n`
+/// points to, Lambertian.
+///
+/// Why one light rather than two triangles: the light point is then one 2D sample over
+/// the whole quad, p = p₀ + u.x·e₁ + u.y·e₂, so a stratified 2D request (Sobol') is
+/// stratified over the whole lamp; with two triangle lights, the 1D light pick splits the
+/// samples between the triangles and each triangle gets a random half of the net. The
+/// warp is also cheaper (no fold) and the light sampler has one light fewer to pick.
+///
+/// Sampled uniformly by area; the density in solid angle at the shading point is
+/// p_ω = d² / (|cos θ_l| · A), as for [`TriangleLight`].
+#[derive(Clone, Debug)]
+pub struct ParallelogramLight {
+    pub p0: Vec3,
+    pub e1: Vec3,
+    pub e2: Vec3,
+    /// Unit normal of the emitting side.
+    pub n: Vec3,
+    pub area: f32,
+    pub le: Vec3,
+    /// Dual vectors of (e₁, e₂) in the plane: (q − p₀)·`d1` = a, (q − p₀)·`d2` = b.
+    d1: Vec3,
+    d2: Vec3,
+}
+
+impl ParallelogramLight {
+    /// A light for the parallelogram p0 + a·e1 + b·e2 with unit normal `n` (the emitting
+    /// side; it should be ±(e1 × e2) normalized). `None` where it is degenerate.
+    pub fn new(p0: Vec3, e1: Vec3, e2: Vec3, n: Vec3, le: Vec3) -> Option<ParallelogramLight> {
+        let c = e1.cross(e2);
+        let area = c.length();
+        if !(area > 0.0 && area.is_finite()) {
+            return None;
+        }
+        // Solve q = a·e1 + b·e2 in the plane: a = q·(e2 × c)/|c|², b = q·(c × e1)/|c|².
+        let inv = 1.0 / (area * area);
+        Some(ParallelogramLight {
+            p0,
+            e1,
+            e2,
+            n,
+            area,
+            le,
+            d1: e2.cross(c) * inv,
+            d2: c.cross(e1) * inv,
+        })
+    }
+
+    /// The parallelogram the two triangles `a` and `b` tile exactly, if they do: they
+    /// share an edge, their other two corners are opposite (the diagonals bisect each
+    /// other, to a relative 10⁻⁶ of the size), both emit `le` towards the same normal and
+    /// neither is shaped by a profile. Then sampling the parallelogram samples the union
+    /// of the triangles, so a ray that hits either finds this light with the same pdf.
+    pub fn from_triangles(a: &TriangleLight, b: &TriangleLight) -> Option<ParallelogramLight> {
+        if a.profile.is_some() || b.profile.is_some() || a.le != b.le {
+            return None;
+        }
+        if a.n.dot(b.n) < 1.0 - 1e-6 || a.area == 0.0 || b.area == 0.0 {
+            return None;
+        }
+        // The corner of `a` that `b` lacks, and the corner of `b` that `a` lacks.
+        let lone = |t: &TriangleLight, o: &TriangleLight| -> Option<usize> {
+            let shared = t.p.map(|q| o.p.contains(&q));
+            if shared.iter().filter(|s| **s).count() != 2 {
+                return None;
+            }
+            shared.iter().position(|s| !s)
+        };
+        let (ia, ib) = (lone(a, b)?, lone(b, a)?);
+        let (x, y) = (a.p[ia], b.p[ib]);
+        let s0 = a.p[(ia + 1) % 3];
+        let s1 = a.p[(ia + 2) % 3];
+        let size = (s0 - x).abs().max((s1 - x).abs()).max_element();
+        if ((x + y) - (s0 + s1)).abs().max_element() > 1e-6 * size {
+            return None;
+        }
+        ParallelogramLight::new(x, s0 - x, s1 - x, a.n, a.le)
+    }
+
+    pub fn sample_li(&self, ctx: &ShadingCtx, u: Vec2) -> Option<LightSample> {
+        let p = self.p0 + self.e1 * u.x + self.e2 * u.y;
+        let to = p - ctx.p;
+        let d2 = to.length_squared();
+        if d2 == 0.0 {
+            return None;
+        }
+        let distance = d2.sqrt();
+        let wi = to * (1.0 / distance);
+        let cos_l = -wi.dot(self.n);
+        if cos_l <= 0.0 {
+            return None;
+        }
+        Some(LightSample {
+            radiance: self.le,
+            wi,
+            distance,
+            pdf: d2 / (cos_l * self.area),
+            is_delta: false,
+            p_light: p,
+            n_light: self.n,
+        })
+    }
+
+    pub fn pdf_li(&self, ctx: &ShadingCtx, wi: Vec3) -> f32 {
+        let cos_l = -wi.dot(self.n);
+        if cos_l <= 0.0 {
+            return 0.0;
+        }
+        // Ray–plane distance, then the point's parallelogram coordinates.
+        let t = (self.p0 - ctx.p).dot(self.n) / -cos_l;
+        if !(t > 0.0 && t.is_finite()) {
+            return 0.0;
+        }
+        let q = ctx.p + wi * t - self.p0;
+        let (a, b) = (q.dot(self.d1), q.dot(self.d2));
+        if !((0.0..=1.0).contains(&a) && (0.0..=1.0).contains(&b)) {
+            return 0.0;
+        }
+        t * t / (cos_l * self.area)
+    }
+
+    pub fn radiance(&self, n: Vec3, w: Vec3) -> Vec3 {
+        if n.dot(w) > 0.0 {
+            self.le
+        } else {
+            Vec3::ZERO
+        }
+    }
+
+    /// Φ = π · A · L for a one-sided Lambertian emitter.
+    pub fn power(&self) -> f32 {
+        std::f32::consts::PI * self.area * luminance(self.le)
+    }
+
+    fn corners(&self) -> [Vec3; 4] {
+        [
+            self.p0,
+            self.p0 + self.e1,
+            self.p0 + self.e1 + self.e2,
+            self.p0 + self.e2,
+        ]
+    }
+
+    /// As [`TriangleLight::importance`], with the solid angle of the two triangles
+    /// (p₀, p₁, p₂) and (p₀, p₂, p₃) summed.
+    pub fn importance(&self, ctx: &ShadingCtx) -> f32 {
+        if (ctx.p - self.p0).dot(self.n) <= 0.0 {
+            return 0.0;
+        }
+        let [a, b, c, d] = self.corners().map(|q| q - ctx.p);
+        let (la, lb, lc, ld) = (a.length(), b.length(), c.length(), d.length());
+        let solid = |a: Vec3, b: Vec3, c: Vec3, la: f32, lb: f32, lc: f32| {
+            let num = a.dot(b.cross(c)).abs();
+            let den = la * lb * lc + a.dot(b) * lc + a.dot(c) * lb + b.dot(c) * la;
+            2.0 * num.atan2(den)
+        };
+        let omega = solid(a, b, c, la, lb, lc) + solid(a, c, d, la, lc, ld);
+        let cos_r = [a / la, b / lb, c / lc, d / ld]
+            .iter()
+            .map(|w| receiver_cos(ctx, *w))
+            .fold(0.0f32, f32::max);
+        luminance(self.le) * omega.max(1e-12) * cos_r
+    }
+
+    /// One-sided Lambertian emitter: normal cone of zero width, emission up to 90°;
+    /// peak intensity L·A along the normal.
+    pub fn bounds(&self) -> LightBounds {
+        LightBounds {
+            aabb: Aabb::from_points(&self.corners()),
+            w: self.n,
+            intensity: luminance(self.le) * self.area,
+            cos_theta_o: 1.0,
+            cos_theta_e: 0.0,
+            two_sided: false,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn tri(p: [Vec3; 3], le: Vec3) -> TriangleLight {
+        let n = (p[1] - p[0]).cross(p[2] - p[0]).normalize();
+        TriangleLight::new(p, n, le)
+    }
+
+    #[test]
+    fn a_quad_split_on_its_diagonal_is_one_parallelogram() {
+        // The Cornell box lamp: f 1 2 3, f 1 3 4.
+        let v = [
+            Vec3::new(0.343, 0.5487, 0.227),
+            Vec3::new(0.343, 0.5487, 0.332),
+            Vec3::new(0.213, 0.5487, 0.332),
+            Vec3::new(0.213, 0.5487, 0.227),
+        ];
+        let le = Vec3::new(17.0, 12.0, 4.0);
+        let (a, b) = (tri([v[0], v[1], v[2]], le), tri([v[0], v[2], v[3]], le));
+        let p = ParallelogramLight::from_triangles(&a, &b).expect("a parallelogram");
+        assert!((p.area - (a.area + b.area)).abs() < 1e-7);
+        assert_eq!(p.n, a.n);
+        assert!((p.power() - (a.power() + b.power())).abs() < 1e-4 * p.power());
+        let mut corners = p.corners().to_vec();
+        corners.sort_by(|x, y| x.to_array().partial_cmp(&y.to_array()).unwrap());
+        let mut want = v.to_vec();
+        want.sort_by(|x, y| x.to_array().partial_cmp(&y.to_array()).unwrap());
+        for (c, w) in corners.iter().zip(&want) {
+            assert!((*c - *w).length() < 1e-6, "{c} vs {w}");
+        }
+        // The importance is that of the two triangles' solid angles together.
+        let ctx = ShadingCtx {
+            p: Vec3::new(0.3, 0.1, 0.25),
+            n: Vec3::Y,
+        };
+        // (L·(Ω_a + Ω_b)·max cos over four corners, each triangle's max over three; below
+        // the lamp the corners' cosines differ by a few per cent.)
+        let sum = a.importance(&ctx) + b.importance(&ctx);
+        assert!(
+            p.importance(&ctx) >= sum * (1.0 - 1e-5),
+            "{} vs {sum}",
+            p.importance(&ctx)
+        );
+        assert!(
+            p.importance(&ctx) < sum * 1.1,
+            "{} vs {sum}",
+            p.importance(&ctx)
+        );
+    }
+
+    #[test]
+    fn triangles_that_do_not_tile_a_parallelogram_stay_apart() {
+        let le = Vec3::ONE;
+        let (o, x, y) = (Vec3::ZERO, Vec3::X, Vec3::Y);
+        let a = tri([o, x, y], le);
+        // A kite: shares the edge x–y, but its far corner is not x + y.
+        assert!(
+            ParallelogramLight::from_triangles(&a, &tri([x, Vec3::new(1.2, 1.1, 0.0), y], le))
+                .is_none()
+        );
+        // Folded: the far corner is off the plane.
+        assert!(
+            ParallelogramLight::from_triangles(&a, &tri([x, Vec3::new(1.0, 1.0, 0.3), y], le))
+                .is_none()
+        );
+        // Different emission, or no shared edge.
+        assert!(ParallelogramLight::from_triangles(&a, &tri([x, x + y, y], le * 2.0)).is_none());
+        let far = Vec3::new(5.0, 0.0, 0.0);
+        assert!(
+            ParallelogramLight::from_triangles(&a, &tri([far + x, far + x + y, far + y], le))
+                .is_none()
+        );
+        // Opposite windings (normals) are two lights.
+        assert!(ParallelogramLight::from_triangles(&a, &tri([x, y, x + y], le)).is_none());
+        assert!(ParallelogramLight::from_triangles(&a, &tri([x, x + y, y], le)).is_some());
+    }
+
+    #[test]
+    fn pdf_li_is_zero_off_the_parallelogram_and_behind_it() {
+        let p = ParallelogramLight::new(Vec3::ZERO, Vec3::X, Vec3::Y * 2.0, -Vec3::Z, Vec3::ONE)
+            .unwrap();
+        let ctx = ShadingCtx {
+            p: Vec3::new(0.5, 1.0, -1.0),
+            n: Vec3::Z,
+        };
+        assert!((p.pdf_li(&ctx, Vec3::Z) - 1.0 / 2.0).abs() < 1e-6);
+        let off = (Vec3::new(1.2, 1.0, 0.0) - ctx.p).normalize();
+        assert_eq!(p.pdf_li(&ctx, off), 0.0);
+        assert_eq!(p.pdf_li(&ctx, -Vec3::Z), 0.0);
+        let behind = ShadingCtx {
+            p: Vec3::new(0.5, 1.0, 1.0),
+            n: Vec3::Z,
+        };
+        assert_eq!(p.pdf_li(&behind, -Vec3::Z), 0.0);
+        assert!(p.sample_li(&behind, Vec2::splat(0.5)).is_none());
+        assert_eq!(p.importance(&behind), 0.0);
+    }
+}
