@@ -134,17 +134,20 @@ impl Block {
             _mm_set1_ps(w.shear.y),
             _mm_set1_ps(w.shear.z),
         );
-        let ld = |vertex: usize, axis: usize| _mm_load_ps(self.v[vertex][axis].as_ptr());
-        // Vertex relative to the origin, sheared: (x, y) and the unscaled z.
-        let rel = |vertex: usize| {
-            let z = _mm_sub_ps(ld(vertex, kz), oz);
-            let x = _mm_sub_ps(_mm_sub_ps(ld(vertex, kx), ox), _mm_mul_ps(sx, z));
-            let y = _mm_sub_ps(_mm_sub_ps(ld(vertex, ky), oy), _mm_mul_ps(sy, z));
-            (x, y, z)
-        };
-        let (ax, ay, a_z) = rel(0);
-        let (bx, by, b_z) = rel(1);
-        let (cx, cy, c_z) = rel(2);
+        // Vertex relative to the origin, sheared: (x, y) and the unscaled z. (A macro:
+        // closures here were left out of line, three calls a block.)
+        macro_rules! rel {
+            ($vertex:expr) => {{
+                let ld = |axis: usize| _mm_load_ps(self.v[$vertex][axis].as_ptr());
+                let z = _mm_sub_ps(ld(kz), oz);
+                let x = _mm_sub_ps(_mm_sub_ps(ld(kx), ox), _mm_mul_ps(sx, z));
+                let y = _mm_sub_ps(_mm_sub_ps(ld(ky), oy), _mm_mul_ps(sy, z));
+                (x, y, z)
+            }};
+        }
+        let (ax, ay, a_z) = rel!(0);
+        let (bx, by, b_z) = rel!(1);
+        let (cx, cy, c_z) = rel!(2);
         let u = _mm_sub_ps(_mm_mul_ps(cx, by), _mm_mul_ps(cy, bx));
         let v = _mm_sub_ps(_mm_mul_ps(ax, cy), _mm_mul_ps(ay, cx));
         let ww = _mm_sub_ps(_mm_mul_ps(bx, ay), _mm_mul_ps(by, ax));
@@ -204,6 +207,30 @@ impl Block {
                     t: ts[lane],
                     b1: 0.0,
                     b2: 0.0,
+                },
+            });
+        }
+        if on_edge == 0 {
+            // The nearest lane without a loop: the minimum of the hit lanes' distances
+            // (misses at +∞), then the lowest lane that has it.
+            let tm = _mm_or_ps(
+                _mm_and_ps(ok, t),
+                _mm_andnot_ps(ok, _mm_set1_ps(f32::INFINITY)),
+            );
+            let m = _mm_min_ps(tm, _mm_shuffle_ps::<0b10_11_00_01>(tm, tm));
+            let m = _mm_min_ps(m, _mm_shuffle_ps::<0b01_00_11_10>(m, m));
+            let lane = (_mm_movemask_ps(_mm_cmpeq_ps(tm, m)) as u32 & mask).trailing_zeros();
+            let lane = lane as usize;
+            let mut vs = [0.0f32; 4];
+            let mut ws = [0.0f32; 4];
+            _mm_storeu_ps(vs.as_mut_ptr(), _mm_mul_ps(v, inv_det));
+            _mm_storeu_ps(ws.as_mut_ptr(), _mm_mul_ps(ww, inv_det));
+            return Some(LaneHit {
+                id: self.id[lane] & ID_MASK,
+                hit: TriangleHit {
+                    t: ts[lane],
+                    b1: vs[lane],
+                    b2: ws[lane],
                 },
             });
         }

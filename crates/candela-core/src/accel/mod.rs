@@ -201,21 +201,26 @@ impl Accel {
     ) -> Option<Hit> {
         let wray = WatertightRay::new(ray);
         let mut best: Option<Hit> = None;
-        self.bvh.intersect::<K>(ray, t_max, |block, count, t_max| {
-            let block = &self.blocks[block as usize];
-            match block.intersect::<SIMD, false>(ray, &wray, count, t_max, filter) {
-                Some(h) => {
-                    best = Some(Hit {
-                        prim: h.id,
-                        t: h.hit.t,
-                        b1: h.hit.b1,
-                        b2: h.hit.b2,
-                    });
-                    h.hit.t
+        self.bvh.intersect::<K>(
+            ray,
+            t_max,
+            #[inline(always)]
+            |block, count, t_max| {
+                let block = &self.blocks[block as usize];
+                match block.intersect::<SIMD, false>(ray, &wray, count, t_max, filter) {
+                    Some(h) => {
+                        best = Some(Hit {
+                            prim: h.id,
+                            t: h.hit.t,
+                            b1: h.hit.b1,
+                            b2: h.hit.b2,
+                        });
+                        h.hit.t
+                    }
+                    None => t_max,
                 }
-                None => t_max,
-            }
-        });
+            },
+        );
         best
     }
 
@@ -229,10 +234,15 @@ impl Accel {
         filter: &impl Fn(u32, &TriangleHit) -> bool,
     ) -> bool {
         let wray = WatertightRay::new(ray);
-        self.bvh.occluded::<K>(ray, t_max, |block, count, t_max| {
-            self.blocks[block as usize]
-                .intersect::<SIMD, true>(ray, &wray, count, t_max, filter)
-                .is_some()
-        })
+        self.bvh.occluded::<K>(
+            ray,
+            t_max,
+            #[inline(always)]
+            |block, count, t_max| {
+                self.blocks[block as usize]
+                    .intersect::<SIMD, true>(ray, &wray, count, t_max, filter)
+                    .is_some()
+            },
+        )
     }
 }
