@@ -220,6 +220,11 @@ impl Accel {
                     None => t_max,
                 }
             },
+            #[inline(always)]
+            |block| {
+                let at = self.blocks.as_ptr().wrapping_add(block as usize);
+                crate::bvh::prefetch(at as *const u8, 3)
+            },
         );
         best
     }

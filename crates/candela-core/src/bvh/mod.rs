@@ -20,4 +20,4 @@ pub use binary::{Bvh, BvhNode};
 pub use box8::{hit8_scalar, BoxTest, Planes8, Ray8, ScalarBoxes, Simd, T_MAX_SCALE};
 #[cfg(target_arch = "x86_64")]
 pub use box8::{Avx2Boxes, SseBoxes};
-pub use wide::{Node8, WideBvh};
+pub use wide::{prefetch, Node8, WideBvh};
