@@ -54,10 +54,10 @@ impl Ray8 {
 /// [`Simd::best`] is what the CPU runs fastest, and the tests run every one it has.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum Simd {
-    /// Plain Rust, lane by lane.
+    /// Plain Rust, lane by lane (the default: it runs everywhere).
+    #[default]
     Scalar,
     /// 4-lane SSE (x86-64 baseline).
-    #[default]
     Sse,
     /// 8-lane AVX2 box tests, 4-lane triangle tests in VEX encoding.
     Avx2,
