@@ -59,6 +59,7 @@ def bench(example, scene, folder, repeats):
     rel = np.abs(res["tfar"][both] - hits["t"][both]) / np.maximum(hits["t"][both], 1e-30)
     return {
         "scene": scene,
+        "simd": candela.get("simd", "?"),
         "triangles": len(tris),
         "rays": n,
         "candela_build_s": candela["build_s"],
@@ -82,7 +83,8 @@ def main():
         os.makedirs(folder, exist_ok=True)
         rows.append(bench(example, scene, folder, repeats))
     print(f"cores this process may use: {sorted(os.sched_getaffinity(0))}; "
-          f"{repeats} alternating rounds, best of each side")
+          f"{repeats} alternating rounds, best of each side; "
+          f"Candela's kernels: {', '.join(sorted({r['simd'] for r in rows}))}")
     print()
     print("| scene | triangles | rays | Candela closest (M rays/s) | Embree closest | ratio "
           "| Candela any-hit | Embree any-hit | ratio | same hit/miss | same triangle | build Candela / Embree (s) |")

@@ -12,6 +12,9 @@
 //! `candela_hits.bin` (per ray: u32 triangle or u32::MAX, f32 t) for
 //! `bench/traversal.py`, which traces the same rays with Embree and compares.
 //!
+//! `CANDELA_SIMD=scalar|sse|avx2` forces the kernels (default: the best the CPU has; the
+//! JSON line says which ran).
+//!
 //! `traversal build [TRIANGLES]` times the BVH build of a generated displaced-sphere mesh
 //! (default 10⁶ triangles) on the rayon pool (`RAYON_NUM_THREADS=2` for two cores).
 
@@ -19,7 +22,7 @@ use std::io::Write;
 use std::path::Path;
 use std::time::Instant;
 
-use candela_core::accel::{accept_all, Accel, Shape};
+use candela_core::accel::{accept_all, Accel, Shape, Simd};
 use candela_core::geometry::Ray;
 use candela_core::math::{offset_ray_origin, Frame};
 use candela_core::sampler::Pcg32;
@@ -164,7 +167,7 @@ fn rays_bench(scene: &str, out: &Path, n_rays: usize) {
         other => panic!("unknown scene {other:?}: cornell or room"),
     };
     let t0 = Instant::now();
-    let accel = Accel::build(&shapes(&tris), |_| false);
+    let accel = Accel::build_for(&shapes(&tris), |_| false, simd_from_env());
     let build_s = t0.elapsed().as_secs_f64();
 
     // Diffuse-bounce rays from primary hits.
@@ -234,13 +237,26 @@ fn rays_bench(scene: &str, out: &Path, n_rays: usize) {
     }
     let n = rays.len() as f64;
     println!(
-        "{{\"scene\": \"{scene}\", \"triangles\": {}, \"rays\": {}, \"hit\": {found}, \"build_s\": {build_s:.4}, \
-         \"closest_mrays_s\": {:.3}, \"any_mrays_s\": {:.3}}}",
+        "{{\"scene\": \"{scene}\", \"simd\": \"{:?}\", \"triangles\": {}, \"rays\": {}, \"hit\": {found}, \
+         \"build_s\": {build_s:.4}, \"closest_mrays_s\": {:.3}, \"any_mrays_s\": {:.3}}}",
+        accel.simd(),
         tris.len(),
         rays.len(),
         n / closest / 1e6,
         n / any / 1e6
     );
+}
+
+/// The kernels to trace with: `CANDELA_SIMD=scalar|sse|avx2` to measure a fallback, else
+/// the best this CPU has.
+fn simd_from_env() -> Simd {
+    match std::env::var("CANDELA_SIMD").as_deref() {
+        Ok("scalar") => Simd::Scalar,
+        Ok("sse") => Simd::Sse,
+        Ok("avx2") => Simd::Avx2,
+        Ok(other) => panic!("CANDELA_SIMD={other:?}: scalar, sse or avx2"),
+        Err(_) => Simd::best(),
+    }
 }
 
 /// The fastest of `runs` timings of `f`, in seconds: the least disturbed by other load.

@@ -125,21 +125,37 @@ pub struct WatertightRay {
 }
 
 impl WatertightRay {
+    #[inline]
     pub fn new(ray: &Ray) -> WatertightRay {
         let d = ray.d;
-        let kz = d.abs().max_position();
-        let mut kx = (kz + 1) % 3;
-        let mut ky = (kx + 1) % 3;
-        if d[kz] < 0.0 {
-            std::mem::swap(&mut kx, &mut ky);
+        // `d.abs().max_position()`, and the other two axes in cyclic order, written out:
+        // once per traced ray, the index arithmetic and checks cost as much as a box test.
+        let a = d.abs();
+        let (mut kz, mut max) = (0, a.x);
+        if a.y > max {
+            (kz, max) = (1, a.y);
         }
-        let sz = 1.0 / d[kz];
+        if a.z > max {
+            kz = 2;
+        }
+        let (x, y, z) = match kz {
+            0 => (d.y, d.z, d.x),
+            1 => (d.z, d.x, d.y),
+            _ => (d.x, d.y, d.z),
+        };
+        let (mut kx, mut ky) = ((kz + 1) % 3, (kz + 2) % 3);
+        let (mut dx, mut dy) = (x, y);
+        if z < 0.0 {
+            (kx, ky) = (ky, kx);
+            (dx, dy) = (dy, dx);
+        }
+        let sz = 1.0 / z;
         WatertightRay {
             o: ray.o,
             kx,
             ky,
             kz,
-            shear: Vec3::new(d[kx] * sz, d[ky] * sz, sz),
+            shear: Vec3::new(dx * sz, dy * sz, sz),
         }
     }
 

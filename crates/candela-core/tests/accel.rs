@@ -8,8 +8,13 @@
 //!
 //! The alpha-mask path: flagging every other triangle and rejecting it in the filter must
 //! give the same hits as building without those triangles.
+//!
+//! Every SIMD kernel set the CPU has (`Simd::available`, always including the scalar
+//! fallback) is checked the same way, and each must return exactly what the scalar one
+//! returns (same primitive even in ties, same t and barycentric bits): their box tests
+//! give the same bits, so they walk the tree in the same order.
 
-use candela_core::accel::{accept_all, Accel, Hit, Shape};
+use candela_core::accel::{accept_all, Accel, Hit, Shape, Simd};
 use candela_core::bvh::Bvh;
 use candela_core::geometry::{intersect_sphere, Aabb, Ray, WatertightRay};
 use candela_core::sampler::Pcg32;
@@ -92,9 +97,14 @@ fn random_rays(rng: &mut Pcg32, shapes: &[Shape], bounds: Aabb, n: usize) -> Vec
         .collect()
 }
 
-/// Checks every ray against brute force and the binary BVH; returns how many hit.
+/// Checks every ray against brute force and the binary BVH, with every kernel set;
+/// returns how many hit.
 fn check_scene(name: &str, shapes: &[Shape], rays: &[Ray], rng: &mut Pcg32) -> usize {
-    let accel = Accel::build(shapes, |_| false);
+    let accels: Vec<Accel> = Simd::available()
+        .into_iter()
+        .map(|simd| Accel::build_for(shapes, |_| false, simd))
+        .collect();
+    assert_eq!(accels[0].simd(), Simd::Scalar);
     let binary = Bvh::build(&boxes(shapes));
     let mut hits = 0;
     for (k, ray) in rays.iter().enumerate() {
@@ -105,34 +115,45 @@ fn check_scene(name: &str, shapes: &[Shape], rays: &[Ray], rng: &mut Pcg32) -> u
         };
         let brute = brute_force(shapes, ray, t_max);
         let old = binary.intersect(ray, t_max, |i, t| test_shape(&shapes[i as usize], ray, t));
-        let new = accel.intersect(ray, t_max, accept_all);
-        let new_pt = new.map(|h: Hit| (h.prim, h.t));
-        for (what, reference) in [("brute force", brute), ("binary BVH", old)] {
-            match (new_pt, reference) {
-                (None, None) => {}
-                (Some((p, t)), Some((q, s))) => {
-                    assert_eq!(
-                        t.to_bits(),
-                        s.to_bits(),
-                        "{name}: ray {k} ({ray:?}): t {t} vs {what} {s}"
-                    );
-                    if p != q {
-                        let tie = test_shape(&shapes[p as usize], ray, f32::INFINITY);
+        let scalar = accels[0].intersect(ray, t_max, accept_all);
+        for accel in &accels {
+            let simd = accel.simd();
+            let new = accel.intersect(ray, t_max, accept_all);
+            assert_eq!(
+                new.map(|h| (h.prim, h.t.to_bits(), h.b1.to_bits(), h.b2.to_bits())),
+                scalar.map(|h| (h.prim, h.t.to_bits(), h.b1.to_bits(), h.b2.to_bits())),
+                "{name}: ray {k} ({ray:?}): {simd:?} vs scalar kernels"
+            );
+            let new_pt = new.map(|h: Hit| (h.prim, h.t));
+            for (what, reference) in [("brute force", brute), ("binary BVH", old)] {
+                match (new_pt, reference) {
+                    (None, None) => {}
+                    (Some((p, t)), Some((q, s))) => {
                         assert_eq!(
-                            tie.map(f32::to_bits),
-                            Some(s.to_bits()),
-                            "{name}: ray {k}: prim {p} vs {what} {q}, and not a tie"
+                            t.to_bits(),
+                            s.to_bits(),
+                            "{name} {simd:?}: ray {k} ({ray:?}): t {t} vs {what} {s}"
                         );
+                        if p != q {
+                            let tie = test_shape(&shapes[p as usize], ray, f32::INFINITY);
+                            assert_eq!(
+                                tie.map(f32::to_bits),
+                                Some(s.to_bits()),
+                                "{name} {simd:?}: ray {k}: prim {p} vs {what} {q}, and not a tie"
+                            );
+                        }
                     }
+                    _ => panic!(
+                        "{name} {simd:?}: ray {k} ({ray:?}): {new_pt:?} vs {what} {reference:?}"
+                    ),
                 }
-                _ => panic!("{name}: ray {k} ({ray:?}): {new_pt:?} vs {what} {reference:?}"),
             }
+            assert_eq!(
+                accel.occluded(ray, t_max, accept_all),
+                brute.is_some(),
+                "{name} {simd:?}: ray {k}: any-hit disagrees"
+            );
         }
-        assert_eq!(
-            accel.occluded(ray, t_max, accept_all),
-            brute.is_some(),
-            "{name}: ray {k}: any-hit disagrees"
-        );
         hits += brute.is_some() as usize;
     }
     hits
@@ -269,14 +290,16 @@ fn rays_inside_box_planes_and_non_finite_rays() {
     }
     let mut rng = Pcg32::new(5, 5);
     check_scene("cube planes", &cube, &rays, &mut rng);
-    let accel = Accel::build(&cube, |_| false);
-    for bad in [
-        Ray::new(Vec3::splat(f32::NAN), Vec3::X),
-        Ray::new(Vec3::splat(0.5), Vec3::splat(f32::NAN)),
-        Ray::new(Vec3::splat(f32::INFINITY), -Vec3::X),
-    ] {
-        assert!(accel.intersect(&bad, f32::INFINITY, accept_all).is_none());
-        assert!(!accel.occluded(&bad, f32::INFINITY, accept_all));
+    for simd in Simd::available() {
+        let accel = Accel::build_for(&cube, |_| false, simd);
+        for bad in [
+            Ray::new(Vec3::splat(f32::NAN), Vec3::X),
+            Ray::new(Vec3::splat(0.5), Vec3::splat(f32::NAN)),
+            Ray::new(Vec3::splat(f32::INFINITY), -Vec3::X),
+        ] {
+            assert!(accel.intersect(&bad, f32::INFINITY, accept_all).is_none());
+            assert!(!accel.occluded(&bad, f32::INFINITY, accept_all));
+        }
     }
 }
 
@@ -285,50 +308,57 @@ fn rejected_hits_are_as_if_the_triangles_were_not_there() {
     let mut rng = Pcg32::new(77, 3);
     let shapes = random_soup(&mut rng, 3000, 40);
     let masked = |i: u32| i % 2 == 1 && matches!(shapes[i as usize], Shape::Triangle(_));
-    let with_filter = Accel::build(&shapes, masked);
     let kept: Vec<u32> = (0..shapes.len() as u32).filter(|&i| !masked(i)).collect();
-    let without = Accel::build(
-        &kept.iter().map(|&i| shapes[i as usize]).collect::<Vec<_>>(),
-        |_| false,
-    );
-    let calls = std::cell::Cell::new(0usize);
-    let reject_odd = |i: u32, _: &_| {
-        calls.set(calls.get() + 1);
-        assert!(masked(i), "the filter is called only for flagged triangles");
-        false
-    };
+    let kept_shapes: Vec<Shape> = kept.iter().map(|&i| shapes[i as usize]).collect();
     let rays = random_rays(&mut rng, &shapes, bounds_of(&shapes), 8000);
-    let mut hits = 0;
-    for ray in &rays {
-        let a = with_filter.intersect(ray, f32::INFINITY, reject_odd);
-        let b = without.intersect(ray, f32::INFINITY, accept_all);
-        assert_eq!(
-            a.map(|h| (h.prim, h.t.to_bits())),
-            b.map(|h| (kept[h.prim as usize], h.t.to_bits()))
+    for simd in Simd::available() {
+        let with_filter = Accel::build_for(&shapes, masked, simd);
+        let without = Accel::build_for(&kept_shapes, |_| false, simd);
+        let calls = std::cell::Cell::new(0usize);
+        let reject_odd = |i: u32, _: &_| {
+            calls.set(calls.get() + 1);
+            assert!(masked(i), "the filter is called only for flagged triangles");
+            false
+        };
+        let mut hits = 0;
+        for (k, ray) in rays.iter().enumerate() {
+            let t_max = if k % 4 == 0 { 3.0 } else { f32::INFINITY };
+            let a = with_filter.intersect(ray, t_max, reject_odd);
+            let b = without.intersect(ray, t_max, accept_all);
+            assert_eq!(
+                a.map(|h| (h.prim, h.t.to_bits())),
+                b.map(|h| (kept[h.prim as usize], h.t.to_bits())),
+                "{simd:?} ray {k}"
+            );
+            assert_eq!(
+                with_filter.occluded(ray, t_max, reject_odd),
+                b.is_some(),
+                "{simd:?} ray {k}"
+            );
+            hits += b.is_some() as usize;
+        }
+        assert!(hits > 1000, "{simd:?}: only {hits} hits");
+        assert!(
+            calls.get() > 1000,
+            "{simd:?}: filter called only {} times",
+            calls.get()
         );
-        assert_eq!(
-            with_filter.occluded(ray, f32::INFINITY, reject_odd),
-            b.is_some()
+        // Accepting everything is the same as no flags at all.
+        let plain = Accel::build_for(&shapes, |_| false, simd);
+        for ray in &rays {
+            assert_eq!(
+                with_filter.intersect(ray, f32::INFINITY, accept_all),
+                plain.intersect(ray, f32::INFINITY, accept_all)
+            );
+            assert_eq!(
+                with_filter.occluded(ray, f32::INFINITY, accept_all),
+                plain.occluded(ray, f32::INFINITY, accept_all)
+            );
+        }
+        eprintln!(
+            "{simd:?}: {} rays, {hits} hit, filter called {} times",
+            rays.len(),
+            calls.get()
         );
-        hits += b.is_some() as usize;
     }
-    assert!(hits > 1000, "only {hits} hits");
-    assert!(
-        calls.get() > 1000,
-        "filter called only {} times",
-        calls.get()
-    );
-    // Accepting everything is the same as no flags at all.
-    let plain = Accel::build(&shapes, |_| false);
-    for ray in &rays {
-        assert_eq!(
-            with_filter.intersect(ray, f32::INFINITY, accept_all),
-            plain.intersect(ray, f32::INFINITY, accept_all)
-        );
-    }
-    eprintln!(
-        "{} rays, {hits} hit, filter called {} times",
-        rays.len(),
-        calls.get()
-    );
 }

@@ -6,10 +6,13 @@
 //! distance and barycentrics are the same bits as the scalar test's. Lanes where an edge
 //! function is exactly zero take the scalar test, which retries those in double precision
 //! as the paper does. Blocks holding a sphere or a filtered triangle take the scalar path
-//! lane by lane.
+//! lane by lane, and so does everything under [`Simd::Scalar`], the reference the tests
+//! compare the four-lane path against.
 
 use glam::Vec3;
 
+#[cfg(doc)]
+use crate::bvh::Simd;
 use crate::geometry::{intersect_sphere, Ray, TriangleHit, WatertightRay};
 
 pub const SPHERE: u32 = 1 << 31;
@@ -18,14 +21,13 @@ pub const ID_MASK: u32 = FILTERED - 1;
 
 /// Up to four primitives. `v[vertex][axis][lane]`; a sphere lane holds its centre in
 /// vertex 0 and its radius in vertex 1's x. `id[lane]` is the primitive index with the
-/// flag bits; unused lanes have NaN vertices, which no test hits.
+/// flag bits; unused lanes have NaN vertices, which no test hits, and id 0. 160 bytes,
+/// aligned so that each block spans three cache lines, not four.
 #[derive(Clone, Copy, Debug)]
-#[repr(C, align(16))]
+#[repr(C, align(32))]
 pub struct Block {
     v: [[[f32; 4]; 3]; 3],
     id: [u32; 4],
-    /// Whether every used lane is an unfiltered triangle (the four-lane path).
-    plain: bool,
 }
 
 /// The nearest hit in a block: lane, and the triangle test's result.
@@ -40,8 +42,7 @@ impl Block {
         debug_assert!(prims.len() <= 4);
         let mut b = Block {
             v: [[[f32::NAN; 4]; 3]; 3],
-            id: [u32::MAX; 4],
-            plain: true,
+            id: [0; 4],
         };
         for (lane, (v, id)) in prims.iter().enumerate() {
             for (vertex, p) in v.iter().enumerate() {
@@ -50,7 +51,6 @@ impl Block {
                 }
             }
             b.id[lane] = *id;
-            b.plain &= id & (SPHERE | FILTERED) == 0;
         }
         b
     }
@@ -60,10 +60,19 @@ impl Block {
         Vec3::new(v[0][lane], v[1][lane], v[2][lane])
     }
 
+    /// Whether every lane is an unfiltered triangle (the four-lane path).
+    #[inline(always)]
+    fn plain(&self) -> bool {
+        (self.id[0] | self.id[1] | self.id[2] | self.id[3]) & (SPHERE | FILTERED) == 0
+    }
+
     /// The nearest hit among the first `count` lanes within (0, t_max) that `filter`
     /// accepts (asked only for flagged triangles). Spheres report zero barycentrics.
+    /// `SIMD` chooses the four-lane test for plain blocks (x86-64 only). With `ANY`, the
+    /// first hit found is returned, not the nearest, and from the four-lane test without
+    /// barycentrics (a shadow ray needs only whether).
     #[inline(always)]
-    pub fn intersect(
+    pub fn intersect<const SIMD: bool, const ANY: bool>(
         &self,
         ray: &Ray,
         wray: &WatertightRay,
@@ -72,9 +81,9 @@ impl Block {
         filter: &impl Fn(u32, &TriangleHit) -> bool,
     ) -> Option<LaneHit> {
         #[cfg(target_arch = "x86_64")]
-        if self.plain {
+        if SIMD && self.plain() {
             // SAFETY: SSE is part of the x86-64 baseline.
-            return unsafe { self.intersect4_sse(wray, count, t_max) };
+            return unsafe { self.intersect4_sse::<ANY>(wray, count, t_max) };
         }
         let mut best = None;
         let mut t_max = t_max;
@@ -99,6 +108,9 @@ impl Block {
                     id: id & ID_MASK,
                     hit,
                 });
+                if ANY {
+                    break;
+                }
             }
         }
         best
@@ -108,7 +120,12 @@ impl Block {
     /// among equals (as a sequential loop that narrows `t_max` would find).
     #[cfg(target_arch = "x86_64")]
     #[inline(always)]
-    unsafe fn intersect4_sse(&self, w: &WatertightRay, count: u32, t_max: f32) -> Option<LaneHit> {
+    unsafe fn intersect4_sse<const ANY: bool>(
+        &self,
+        w: &WatertightRay,
+        count: u32,
+        t_max: f32,
+    ) -> Option<LaneHit> {
         use std::arch::x86_64::*;
         let (kx, ky, kz) = (w.kx, w.ky, w.kz);
         let o = w.o.to_array();
@@ -118,17 +135,20 @@ impl Block {
             _mm_set1_ps(w.shear.y),
             _mm_set1_ps(w.shear.z),
         );
-        let ld = |vertex: usize, axis: usize| _mm_load_ps(self.v[vertex][axis].as_ptr());
-        // Vertex relative to the origin, sheared: (x, y) and the unscaled z.
-        let rel = |vertex: usize| {
-            let z = _mm_sub_ps(ld(vertex, kz), oz);
-            let x = _mm_sub_ps(_mm_sub_ps(ld(vertex, kx), ox), _mm_mul_ps(sx, z));
-            let y = _mm_sub_ps(_mm_sub_ps(ld(vertex, ky), oy), _mm_mul_ps(sy, z));
-            (x, y, z)
-        };
-        let (ax, ay, a_z) = rel(0);
-        let (bx, by, b_z) = rel(1);
-        let (cx, cy, c_z) = rel(2);
+        // Vertex relative to the origin, sheared: (x, y) and the unscaled z. (A macro:
+        // closures here were left out of line, three calls a block.)
+        macro_rules! rel {
+            ($vertex:expr) => {{
+                let ld = |axis: usize| _mm_load_ps(self.v[$vertex][axis].as_ptr());
+                let z = _mm_sub_ps(ld(kz), oz);
+                let x = _mm_sub_ps(_mm_sub_ps(ld(kx), ox), _mm_mul_ps(sx, z));
+                let y = _mm_sub_ps(_mm_sub_ps(ld(ky), oy), _mm_mul_ps(sy, z));
+                (x, y, z)
+            }};
+        }
+        let (ax, ay, a_z) = rel!(0);
+        let (bx, by, b_z) = rel!(1);
+        let (cx, cy, c_z) = rel!(2);
         let u = _mm_sub_ps(_mm_mul_ps(cx, by), _mm_mul_ps(cy, bx));
         let v = _mm_sub_ps(_mm_mul_ps(ax, cy), _mm_mul_ps(ay, cx));
         let ww = _mm_sub_ps(_mm_mul_ps(bx, ay), _mm_mul_ps(by, ax));
@@ -179,6 +199,42 @@ impl Block {
         }
         let mut ts = [0.0f32; 4];
         _mm_storeu_ps(ts.as_mut_ptr(), t);
+        if ANY && mask != 0 {
+            // Some lane is hit; a shadow ray needs no more (nor the barycentrics).
+            let lane = mask.trailing_zeros() as usize;
+            return Some(LaneHit {
+                id: self.id[lane] & ID_MASK,
+                hit: TriangleHit {
+                    t: ts[lane],
+                    b1: 0.0,
+                    b2: 0.0,
+                },
+            });
+        }
+        if on_edge == 0 {
+            // The nearest lane without a loop: the minimum of the hit lanes' distances
+            // (misses at +∞), then the lowest lane that has it.
+            let tm = _mm_or_ps(
+                _mm_and_ps(ok, t),
+                _mm_andnot_ps(ok, _mm_set1_ps(f32::INFINITY)),
+            );
+            let m = _mm_min_ps(tm, _mm_shuffle_ps::<0b10_11_00_01>(tm, tm));
+            let m = _mm_min_ps(m, _mm_shuffle_ps::<0b01_00_11_10>(m, m));
+            let lane = (_mm_movemask_ps(_mm_cmpeq_ps(tm, m)) as u32 & mask).trailing_zeros();
+            let lane = lane as usize;
+            let mut vs = [0.0f32; 4];
+            let mut ws = [0.0f32; 4];
+            _mm_storeu_ps(vs.as_mut_ptr(), _mm_mul_ps(v, inv_det));
+            _mm_storeu_ps(ws.as_mut_ptr(), _mm_mul_ps(ww, inv_det));
+            return Some(LaneHit {
+                id: self.id[lane] & ID_MASK,
+                hit: TriangleHit {
+                    t: ts[lane],
+                    b1: vs[lane],
+                    b2: ws[lane],
+                },
+            });
+        }
         let mut best: Option<(usize, TriangleHit)> = None;
         let mut best_t = t_max;
         for (lane, &t_lane) in ts.iter().enumerate().take(count as usize) {

@@ -1,6 +1,7 @@
-//! The ray-tracing acceleration structure: a [`WideBvh`] over the scene's primitives,
-//! each leaf's primitives copied into one [`block::Block`] of four lanes with the
-//! vertices inline (no index → mesh → position chase), tested four at a time.
+//! The ray-tracing acceleration structure: a [`WideBvh`] (eight children a node) over the
+//! scene's primitives, each leaf's primitives copied into one [`block::Block`] of four
+//! lanes with the vertices inline (no index → mesh → position chase), tested four at a
+//! time.
 //!
 //! Triangles keep the watertight test (Woop et al. 2013) on the same vertex values as
 //! the meshes, so a hit's distance is the same bits as the mesh's own test gives. Each
@@ -8,14 +9,22 @@
 //! (alpha masks). Blocks without flags never call the filter; a flagged triangle calls
 //! it after its barycentrics are known, and traversal goes on past it when the filter
 //! rejects.
+//!
+//! The SIMD kernels ([`Simd`]) are chosen once, at build: AVX2 box tests where the CPU
+//! has them, else SSE; [`Accel::build_for`] forces one (the tests run each the CPU has
+//! against the scalar one). Every kernel finds the same hits, bit for bit.
 
 mod block;
 
 use glam::Vec3;
 
-use crate::bvh::{Bvh, WideBvh};
+#[cfg(target_arch = "x86_64")]
+use crate::bvh::{Avx2Boxes, SseBoxes};
+use crate::bvh::{BoxTest, Bvh, ScalarBoxes, WideBvh};
 use crate::geometry::{Aabb, Ray, TriangleHit, WatertightRay};
 use block::{Block, FILTERED, ID_MASK, SPHERE};
+
+pub use crate::bvh::Simd;
 
 /// A primitive handed to [`Accel::build`].
 #[derive(Clone, Copy, Debug)]
@@ -55,12 +64,23 @@ pub fn accept_all(_: u32, _: &TriangleHit) -> bool {
 pub struct Accel {
     bvh: WideBvh,
     blocks: Vec<Block>,
+    simd: Simd,
 }
 
 impl Accel {
     /// Builds over `shapes`; `filtered(i)` says whether hits on triangle `i` must pass
     /// the filter. Primitives with empty or non-finite boxes are left out.
     pub fn build(shapes: &[Shape], filtered: impl Fn(u32) -> bool) -> Accel {
+        Accel::build_for(shapes, filtered, Simd::best())
+    }
+
+    /// [`Accel::build`] with the given kernels, which must be supported by this CPU
+    /// ([`Simd::available`]); for tests and benchmarks.
+    pub fn build_for(shapes: &[Shape], filtered: impl Fn(u32) -> bool, simd: Simd) -> Accel {
+        assert!(
+            simd.is_supported(),
+            "{simd:?} kernels on a CPU without them"
+        );
         assert!(
             shapes.len() < ID_MASK as usize,
             "at most 2^30 primitives per scene"
@@ -87,17 +107,22 @@ impl Accel {
         }
         let mut bvh = WideBvh::collapse(&binary);
         for node in &mut bvh.nodes {
-            for lane in 0..4 {
+            for lane in 0..node.child.len() {
                 if node.count[lane] > 0 {
                     node.child[lane] = block_of[node.child[lane] as usize];
                 }
             }
         }
-        Accel { bvh, blocks }
+        Accel { bvh, blocks, simd }
     }
 
     pub fn bounds(&self) -> Aabb {
         self.bvh.bounds()
+    }
+
+    /// The kernels this structure traces with.
+    pub fn simd(&self) -> Simd {
+        self.simd
     }
 
     /// The nearest hit within (0, t_max); hits on flagged triangles count only where
@@ -109,23 +134,16 @@ impl Accel {
         t_max: f32,
         filter: impl Fn(u32, &TriangleHit) -> bool,
     ) -> Option<Hit> {
-        let wray = WatertightRay::new(ray);
-        let mut best: Option<Hit> = None;
-        self.bvh.intersect(ray, t_max, |block, count, t_max| {
-            match self.blocks[block as usize].intersect(ray, &wray, count, t_max, &filter) {
-                Some(h) => {
-                    best = Some(Hit {
-                        prim: h.id,
-                        t: h.hit.t,
-                        b1: h.hit.b1,
-                        b2: h.hit.b2,
-                    });
-                    h.hit.t
-                }
-                None => t_max,
+        // SAFETY: `build_for` checked that the CPU supports `self.simd`.
+        unsafe {
+            match self.simd {
+                #[cfg(target_arch = "x86_64")]
+                Simd::Avx2 => self.intersect_avx2(ray, t_max, &filter),
+                #[cfg(target_arch = "x86_64")]
+                Simd::Sse => self.intersect_with::<SseBoxes, true>(ray, t_max, &filter),
+                _ => self.intersect_with::<ScalarBoxes, false>(ray, t_max, &filter),
             }
-        });
-        best
+        }
     }
 
     /// Whether anything accepted by `filter` lies on the ray within (0, t_max); stops
@@ -137,11 +155,99 @@ impl Accel {
         t_max: f32,
         filter: impl Fn(u32, &TriangleHit) -> bool,
     ) -> bool {
+        // SAFETY: `build_for` checked that the CPU supports `self.simd`.
+        unsafe {
+            match self.simd {
+                #[cfg(target_arch = "x86_64")]
+                Simd::Avx2 => self.occluded_avx2(ray, t_max, &filter),
+                #[cfg(target_arch = "x86_64")]
+                Simd::Sse => self.occluded_with::<SseBoxes, true>(ray, t_max, &filter),
+                _ => self.occluded_with::<ScalarBoxes, false>(ray, t_max, &filter),
+            }
+        }
+    }
+
+    /// The traversal compiled with AVX2 enabled, so that its box kernel inlines.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    unsafe fn intersect_avx2<F: Fn(u32, &TriangleHit) -> bool>(
+        &self,
+        ray: &Ray,
+        t_max: f32,
+        filter: &F,
+    ) -> Option<Hit> {
+        self.intersect_with::<Avx2Boxes, true>(ray, t_max, filter)
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    unsafe fn occluded_avx2<F: Fn(u32, &TriangleHit) -> bool>(
+        &self,
+        ray: &Ray,
+        t_max: f32,
+        filter: &F,
+    ) -> bool {
+        self.occluded_with::<Avx2Boxes, true>(ray, t_max, filter)
+    }
+
+    /// # Safety
+    /// The CPU must support `K`.
+    #[inline(always)]
+    unsafe fn intersect_with<K: BoxTest, const SIMD: bool>(
+        &self,
+        ray: &Ray,
+        t_max: f32,
+        filter: &impl Fn(u32, &TriangleHit) -> bool,
+    ) -> Option<Hit> {
         let wray = WatertightRay::new(ray);
-        self.bvh.occluded(ray, t_max, |block, count, t_max| {
-            self.blocks[block as usize]
-                .intersect(ray, &wray, count, t_max, &filter)
-                .is_some()
-        })
+        let mut best: Option<Hit> = None;
+        self.bvh.intersect::<K>(
+            ray,
+            t_max,
+            #[inline(always)]
+            |block, count, t_max| {
+                let block = &self.blocks[block as usize];
+                match block.intersect::<SIMD, false>(ray, &wray, count, t_max, filter) {
+                    Some(h) => {
+                        best = Some(Hit {
+                            prim: h.id,
+                            t: h.hit.t,
+                            b1: h.hit.b1,
+                            b2: h.hit.b2,
+                        });
+                        h.hit.t
+                    }
+                    None => t_max,
+                }
+            },
+            #[inline(always)]
+            |block| {
+                let at = self.blocks.as_ptr().wrapping_add(block as usize);
+                crate::bvh::prefetch(at as *const u8, 3)
+            },
+        );
+        best
+    }
+
+    /// # Safety
+    /// The CPU must support `K`.
+    #[inline(always)]
+    unsafe fn occluded_with<K: BoxTest, const SIMD: bool>(
+        &self,
+        ray: &Ray,
+        t_max: f32,
+        filter: &impl Fn(u32, &TriangleHit) -> bool,
+    ) -> bool {
+        let wray = WatertightRay::new(ray);
+        self.bvh.occluded::<K>(
+            ray,
+            t_max,
+            #[inline(always)]
+            |block, count, t_max| {
+                self.blocks[block as usize]
+                    .intersect::<SIMD, true>(ray, &wray, count, t_max, filter)
+                    .is_some()
+            },
+        )
     }
 }

@@ -7,7 +7,7 @@ use glam::Vec3A;
 
 use super::extents::{Box3A, Extents, PrimInfo};
 
-use super::box4::T_MAX_SCALE;
+use super::box8::T_MAX_SCALE;
 use crate::geometry::{Aabb, Ray};
 
 const BINS: usize = 16;

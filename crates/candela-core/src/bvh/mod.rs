@@ -2,20 +2,22 @@
 //!
 //! [`Bvh`] is the binary tree of the binned SAH build (Wald 2007); it is also kept as the
 //! reference traversal the tests compare against. [`WideBvh`] is that tree collapsed to
-//! four children per node with the children's boxes stored side by side, so that one
-//! SIMD slab test checks all four at once (Wald et al. 2008, "Getting Rid of Packets";
-//! Dammertz et al. 2008, "Shallow Bounding Volume Hierarchies"). That is what the scene
-//! traces rays through.
+//! eight children per node with the children's boxes stored side by side, so that one
+//! SIMD slab test checks all eight at once (Wald et al. 2008, "Getting Rid of Packets";
+//! Dammertz et al. 2008, "Shallow Bounding Volume Hierarchies"; Embree's BVH8). That is
+//! what the scene traces rays through, with the box kernel [`Simd::best`] picks.
 //!
 //! Neither knows of triangles or spheres: traversal calls a closure with the leaf-order
 //! range of each leaf whose box the ray enters, so any primitive type can sit in them
 //! (the scene's [`crate::accel`] lays its primitives out in that order).
 
 mod binary;
-mod box4;
+mod box8;
 mod extents;
 mod wide;
 
 pub use binary::{Bvh, BvhNode};
-pub use box4::{hit4_scalar, Ray4, T_MAX_SCALE};
-pub use wide::{Node4, WideBvh};
+pub use box8::{hit8_scalar, BoxTest, Planes8, Ray8, ScalarBoxes, Simd, T_MAX_SCALE};
+#[cfg(target_arch = "x86_64")]
+pub use box8::{Avx2Boxes, SseBoxes};
+pub use wide::{prefetch, Node8, WideBvh};

@@ -1,0 +1,377 @@
+//! One ray against eight boxes at once: the slab test of [`crate::geometry::Aabb::hit`]
+//! in eight lanes. Three kernels give the same bits: AVX2 (one 8-lane register, where
+//! the CPU has it, checked once at build time), SSE (two 4-lane halves; part of the
+//! x86-64 baseline) and plain scalar code (other targets, and the reference the tests
+//! compare the others with). [`Simd`] names them; the traversal is generic over
+//! [`BoxTest`] and so compiled once per kernel.
+
+use glam::Vec3;
+
+use crate::geometry::{gamma, Ray};
+
+/// Eight boxes, planes as `[min_x, max_x, min_y, max_y, min_z, max_z]`, eight lanes each.
+pub type Planes8 = [[f32; 8]; 6];
+
+/// Robustness factor on far distances (pbrt-v4 §6.8.2), as in `Aabb::hit`. It is folded
+/// into the far planes' reciprocal direction: one more rounding, well inside the 2γ₃
+/// (≈ 3.6·10⁻⁷ relative) margin.
+const FAR_SCALE: f32 = 1.0 + 2.0 * gamma(3);
+
+/// Traversal widens `t_max` by this factor before box tests. A box's entry distance is
+/// rounded, and a triangle test's distance is rounded more (its barycentric sums cancel
+/// at grazing angles), so the box of a hit just nearer than the best so far can appear
+/// to start just beyond it; culling it would return the farther of two hits some ulps
+/// apart. 2⁻¹⁶ (≈ 128 ulps) covers the cases the tests find, and the extra boxes it
+/// opens are too few to measure.
+pub const T_MAX_SCALE: f32 = 1.0 + 1.0 / 65536.0;
+
+/// Per-ray constants of the eight-wide slab test.
+#[derive(Clone, Copy, Debug)]
+pub struct Ray8 {
+    pub o: Vec3,
+    pub inv_d: Vec3,
+    /// `inv_d * FAR_SCALE`, for the far planes.
+    pub inv_far: Vec3,
+    /// Index into [`Planes8`] of each axis's near plane (0/2/4 for a positive direction,
+    /// 1/3/5 for a negative one); the far plane is the other one.
+    pub near: [usize; 3],
+}
+
+impl Ray8 {
+    pub fn new(ray: &Ray) -> Ray8 {
+        let inv_d = ray.d.recip();
+        let near = |axis: usize, inv: f32| 2 * axis + (inv < 0.0) as usize;
+        Ray8 {
+            o: ray.o,
+            inv_d,
+            inv_far: inv_d * FAR_SCALE,
+            near: [near(0, inv_d.x), near(1, inv_d.y), near(2, inv_d.z)],
+        }
+    }
+}
+
+/// Which SIMD kernels the traversal and the triangle blocks use. All give the same bits;
+/// [`Simd::best`] is what the CPU runs fastest, and the tests run every one it has.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Simd {
+    /// Plain Rust, lane by lane (the default: it runs everywhere).
+    #[default]
+    Scalar,
+    /// 4-lane SSE (x86-64 baseline).
+    Sse,
+    /// 8-lane AVX2 box tests, 4-lane triangle tests in VEX encoding.
+    Avx2,
+}
+
+impl Simd {
+    /// The fastest kernel this CPU supports (`is_x86_feature_detected!` caches its
+    /// answer; this is asked once per acceleration-structure build, not per ray).
+    pub fn best() -> Simd {
+        #[cfg(target_arch = "x86_64")]
+        {
+            if std::arch::is_x86_feature_detected!("avx2") {
+                Simd::Avx2
+            } else {
+                Simd::Sse
+            }
+        }
+        #[cfg(not(target_arch = "x86_64"))]
+        {
+            Simd::Scalar
+        }
+    }
+
+    /// Every kernel this CPU can run, scalar first.
+    pub fn available() -> Vec<Simd> {
+        [Simd::Scalar, Simd::Sse, Simd::Avx2]
+            .into_iter()
+            .filter(|s| s.is_supported())
+            .collect()
+    }
+
+    pub fn is_supported(self) -> bool {
+        match self {
+            Simd::Scalar => true,
+            Simd::Sse => cfg!(target_arch = "x86_64"),
+            Simd::Avx2 => Simd::best() == Simd::Avx2,
+        }
+    }
+}
+
+/// An eight-box slab test. Which of the eight boxes the ray meets within (0, t_max)
+/// (bit i for box i), and the entry distances. A plane whose distance is NaN (the ray
+/// lies in it) does not constrain the interval, as in `Aabb::hit`; empty boxes
+/// (min = +∞, max = −∞) are missed by every finite ray.
+pub trait BoxTest {
+    /// The ray's constants as the kernel wants them, made once per ray.
+    type Prepared;
+
+    /// # Safety
+    /// The CPU must support the kernel (see [`Simd::is_supported`]).
+    unsafe fn prepare(ray: &Ray8) -> Self::Prepared;
+
+    /// # Safety
+    /// As for [`BoxTest::prepare`].
+    unsafe fn hit8(ray: &Self::Prepared, planes: &Planes8, t_max: f32) -> (u32, [f32; 8]);
+}
+
+/// `maxps` semantics: the second operand when either is NaN.
+#[inline(always)]
+fn max_ps(a: f32, b: f32) -> f32 {
+    if a > b {
+        a
+    } else {
+        b
+    }
+}
+
+/// `minps` semantics: the second operand when either is NaN.
+#[inline(always)]
+fn min_ps(a: f32, b: f32) -> f32 {
+    if a < b {
+        a
+    } else {
+        b
+    }
+}
+
+/// The portable kernel.
+pub struct ScalarBoxes;
+
+impl BoxTest for ScalarBoxes {
+    type Prepared = Ray8;
+
+    #[inline(always)]
+    unsafe fn prepare(ray: &Ray8) -> Ray8 {
+        *ray
+    }
+
+    #[inline(always)]
+    unsafe fn hit8(ray: &Ray8, planes: &Planes8, t_max: f32) -> (u32, [f32; 8]) {
+        hit8_scalar(ray, planes, t_max)
+    }
+}
+
+/// [`ScalarBoxes`]' test as a safe function, for tests.
+#[inline(always)]
+pub fn hit8_scalar(ray: &Ray8, planes: &Planes8, t_max: f32) -> (u32, [f32; 8]) {
+    let o = ray.o.to_array();
+    let (inv, inv_far) = (ray.inv_d.to_array(), ray.inv_far.to_array());
+    let mut mask = 0;
+    let mut t_near8 = [0.0; 8];
+    for lane in 0..8 {
+        let mut t_near = 0.0f32;
+        let mut t_far = t_max;
+        for axis in 0..3 {
+            let n = ray.near[axis];
+            t_near = max_ps((planes[n][lane] - o[axis]) * inv[axis], t_near);
+            t_far = min_ps((planes[n ^ 1][lane] - o[axis]) * inv_far[axis], t_far);
+        }
+        t_near8[lane] = t_near;
+        if t_near <= t_far {
+            mask |= 1 << lane;
+        }
+    }
+    (mask, t_near8)
+}
+
+#[cfg(target_arch = "x86_64")]
+pub use x86::{Avx2Boxes, SseBoxes};
+
+#[cfg(target_arch = "x86_64")]
+mod x86 {
+    use std::arch::x86_64::*;
+
+    use super::{BoxTest, Planes8, Ray8};
+
+    /// Two 4-lane SSE halves.
+    pub struct SseBoxes;
+
+    /// Per axis: origin, reciprocal direction (near and far), near plane row.
+    #[derive(Clone, Copy)]
+    pub struct SseRay {
+        o: [__m128; 3],
+        inv: [__m128; 3],
+        inv_far: [__m128; 3],
+        near: [usize; 3],
+    }
+
+    impl BoxTest for SseBoxes {
+        type Prepared = SseRay;
+
+        #[inline(always)]
+        unsafe fn prepare(r: &Ray8) -> SseRay {
+            let (o, i, f) = (r.o.to_array(), r.inv_d.to_array(), r.inv_far.to_array());
+            SseRay {
+                o: o.map(|x| _mm_set1_ps(x)),
+                inv: i.map(|x| _mm_set1_ps(x)),
+                inv_far: f.map(|x| _mm_set1_ps(x)),
+                near: r.near,
+            }
+        }
+
+        #[inline(always)]
+        unsafe fn hit8(r: &SseRay, planes: &Planes8, t_max: f32) -> (u32, [f32; 8]) {
+            let mut out = [0.0f32; 8];
+            let mut mask = 0;
+            for half in 0..2 {
+                let mut t_near = _mm_setzero_ps();
+                let mut t_far = _mm_set1_ps(t_max);
+                for axis in 0..3 {
+                    let n = r.near[axis];
+                    let near = _mm_loadu_ps(planes.get_unchecked(n).as_ptr().add(4 * half));
+                    let far = _mm_loadu_ps(planes.get_unchecked(n ^ 1).as_ptr().add(4 * half));
+                    t_near =
+                        _mm_max_ps(_mm_mul_ps(_mm_sub_ps(near, r.o[axis]), r.inv[axis]), t_near);
+                    t_far = _mm_min_ps(
+                        _mm_mul_ps(_mm_sub_ps(far, r.o[axis]), r.inv_far[axis]),
+                        t_far,
+                    );
+                }
+                mask |= (_mm_movemask_ps(_mm_cmple_ps(t_near, t_far)) as u32) << (4 * half);
+                _mm_storeu_ps(out.as_mut_ptr().add(4 * half), t_near);
+            }
+            (mask, out)
+        }
+    }
+
+    /// One 8-lane AVX2 register.
+    pub struct Avx2Boxes;
+
+    #[derive(Clone, Copy)]
+    pub struct Avx2Ray {
+        o: [__m256; 3],
+        inv: [__m256; 3],
+        inv_far: [__m256; 3],
+        near: [usize; 3],
+    }
+
+    impl BoxTest for Avx2Boxes {
+        type Prepared = Avx2Ray;
+
+        #[inline]
+        #[target_feature(enable = "avx2")]
+        unsafe fn prepare(r: &Ray8) -> Avx2Ray {
+            let (o, i, f) = (r.o.to_array(), r.inv_d.to_array(), r.inv_far.to_array());
+            Avx2Ray {
+                o: o.map(|x| _mm256_set1_ps(x)),
+                inv: i.map(|x| _mm256_set1_ps(x)),
+                inv_far: f.map(|x| _mm256_set1_ps(x)),
+                near: r.near,
+            }
+        }
+
+        #[inline]
+        #[target_feature(enable = "avx2")]
+        unsafe fn hit8(r: &Avx2Ray, planes: &Planes8, t_max: f32) -> (u32, [f32; 8]) {
+            let mut t_near = _mm256_setzero_ps();
+            let mut t_far = _mm256_set1_ps(t_max);
+            for axis in 0..3 {
+                let n = r.near[axis];
+                let near = _mm256_loadu_ps(planes.get_unchecked(n).as_ptr());
+                let far = _mm256_loadu_ps(planes.get_unchecked(n ^ 1).as_ptr());
+                t_near = _mm256_max_ps(
+                    _mm256_mul_ps(_mm256_sub_ps(near, r.o[axis]), r.inv[axis]),
+                    t_near,
+                );
+                t_far = _mm256_min_ps(
+                    _mm256_mul_ps(_mm256_sub_ps(far, r.o[axis]), r.inv_far[axis]),
+                    t_far,
+                );
+            }
+            let mask = _mm256_movemask_ps(_mm256_cmp_ps::<_CMP_LE_OQ>(t_near, t_far)) as u32;
+            let mut out = [0.0f32; 8];
+            _mm256_storeu_ps(out.as_mut_ptr(), t_near);
+            (mask, out)
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::sampler::Pcg32;
+
+    /// Every kernel the CPU has gives the scalar kernel's mask and entry bits on random
+    /// boxes, empty slots, flat boxes and rays lying in box planes.
+    #[test]
+    #[allow(clippy::needless_range_loop)] // lanes index two arrays at once
+    fn kernels_agree_bit_for_bit() {
+        let mut rng = Pcg32::new(3, 9);
+        let mut u = || rng.uniform_f32();
+        let mut hits = 0;
+        let simds = Simd::available();
+        assert!(simds.contains(&Simd::best()));
+        eprintln!("kernels on this CPU: {simds:?}");
+        for k in 0..20000 {
+            let mut planes: Planes8 = [[0.0; 8]; 6];
+            for lane in 0..8 {
+                for axis in 0..3 {
+                    let (a, b) = ((u() * 4.0).floor() / 2.0, (u() * 4.0).floor() / 2.0);
+                    let (lo, hi) = match (k + lane) % 5 {
+                        0 => (f32::INFINITY, f32::NEG_INFINITY),
+                        1 => (a, a),
+                        _ => (a.min(b), a.max(b) + 1.0),
+                    };
+                    planes[2 * axis][lane] = lo;
+                    planes[2 * axis + 1][lane] = hi;
+                }
+            }
+            // Origins on the half-integer grid put them in box planes; some direction
+            // components are ±0.
+            let o = Vec3::new(u(), u(), u()) * 4.0 - 1.0;
+            let o = if k % 3 == 0 {
+                (o * 2.0).floor() / 2.0
+            } else {
+                o
+            };
+            let mut d = Vec3::new(u(), u(), u()) - 0.5;
+            if k % 4 == 0 {
+                d.y = 0.0;
+            }
+            if k % 7 == 0 {
+                d.x = -0.0;
+            }
+            let ray = Ray8::new(&Ray::new(o, d));
+            let t_max = if k % 2 == 0 { f32::INFINITY } else { u() * 3.0 };
+            let (m0, t0) = hit8_scalar(&ray, &planes, t_max);
+            for &simd in &simds {
+                // SAFETY: `simds` holds only kernels this CPU supports.
+                let (m, t) = unsafe {
+                    match simd {
+                        Simd::Scalar => {
+                            ScalarBoxes::hit8(&ScalarBoxes::prepare(&ray), &planes, t_max)
+                        }
+                        #[cfg(target_arch = "x86_64")]
+                        Simd::Sse => SseBoxes::hit8(&SseBoxes::prepare(&ray), &planes, t_max),
+                        #[cfg(target_arch = "x86_64")]
+                        Simd::Avx2 => Avx2Boxes::hit8(&Avx2Boxes::prepare(&ray), &planes, t_max),
+                        #[cfg(not(target_arch = "x86_64"))]
+                        _ => unreachable!(),
+                    }
+                };
+                assert_eq!(m, m0, "{simd:?} case {k}");
+                assert_eq!(
+                    t.map(f32::to_bits),
+                    t0.map(f32::to_bits),
+                    "{simd:?} case {k}"
+                );
+            }
+            // The slab test agrees with `Aabb::hit` on which boxes the ray meets.
+            for lane in 0..8 {
+                let b = crate::geometry::Aabb {
+                    min: Vec3::new(planes[0][lane], planes[2][lane], planes[4][lane]),
+                    max: Vec3::new(planes[1][lane], planes[3][lane], planes[5][lane]),
+                };
+                if b.hit(o, ray.inv_d, t_max).is_some() {
+                    assert!(
+                        m0 & (1 << lane) != 0,
+                        "case {k} lane {lane}: Aabb::hit meets it"
+                    );
+                }
+            }
+            hits += m0.count_ones();
+        }
+        assert!(hits > 10000, "only {hits} box hits");
+    }
+}
