@@ -234,47 +234,8 @@ impl Instances {
     /// Visits the instances whose boxes the ray enters, near child first; `visit(instance,
     /// t_max)` returns the new t_max and whether to stop.
     #[inline]
-    fn traverse(&self, ray: &Ray, mut t_max: f32, mut visit: impl FnMut(u32, f32) -> (f32, bool)) {
-        let nodes = &self.tlas.nodes;
-        if nodes.is_empty() {
-            return;
-        }
-        let inv_d = ray.d.recip();
-        let neg = [inv_d.x < 0.0, inv_d.y < 0.0, inv_d.z < 0.0];
-        // The binary build caps its depth near 48 + log2(n) (median splits past 48).
-        let mut stack = [0u32; 128];
-        let mut sp = 0usize;
-        let mut current = 0usize;
-        loop {
-            let node = &nodes[current];
-            if node.bounds.hit(ray.o, inv_d, t_max).is_some() {
-                if node.is_leaf() {
-                    let first = node.offset as usize;
-                    for &inst in &self.tlas.prims[first..first + node.count as usize] {
-                        let (t, stop) = visit(inst, t_max);
-                        if stop {
-                            return;
-                        }
-                        t_max = t;
-                    }
-                } else {
-                    let (near, far) = if neg[node.axis as usize] {
-                        (node.offset as usize, current + 1)
-                    } else {
-                        (current + 1, node.offset as usize)
-                    };
-                    stack[sp] = far as u32;
-                    sp += 1;
-                    current = near;
-                    continue;
-                }
-            }
-            if sp == 0 {
-                return;
-            }
-            sp -= 1;
-            current = stack[sp] as usize;
-        }
+    fn traverse(&self, ray: &Ray, t_max: f32, visit: impl FnMut(u32, f32) -> (f32, bool)) {
+        self.tlas.traverse(ray, visit, t_max);
     }
 }
 

@@ -172,10 +172,17 @@ impl Bvh {
         found
     }
 
-    /// Visits leaves front to back; `visit(prim, t_max)` returns the new `t_max` and
-    /// whether to stop.
+    /// Visits leaves front to back (the near child first, by the ray's direction on the
+    /// node's split axis); `visit(prim, t_max)` returns the new `t_max` and whether to stop.
+    /// Boxes are tested against a `t_max` widened by [`T_MAX_SCALE`], so a leaf a little
+    /// beyond it may be visited: `visit` must apply its own `t_max`.
     #[inline]
-    fn traverse(&self, ray: &Ray, mut visit: impl FnMut(u32, f32) -> (f32, bool), mut t_max: f32) {
+    pub fn traverse(
+        &self,
+        ray: &Ray,
+        mut visit: impl FnMut(u32, f32) -> (f32, bool),
+        mut t_max: f32,
+    ) {
         if self.nodes.is_empty() {
             return;
         }

@@ -80,6 +80,41 @@ pub struct LightSample {
     pub n_light: Vec3,
 }
 
+impl LightSample {
+    /// The sample of point `p`, drawn uniformly by area on a flat one-sided emitter of
+    /// normal `n` and `area`, seen from `from`: the area density turned into solid angle,
+    /// d²/(cos θ_l · A). `radiance(wi)` gives the radiance leaving towards −`wi`. `None`
+    /// where `p` is the shading point itself or faces away.
+    pub fn uniform_area(
+        from: Vec3,
+        p: Vec3,
+        n: Vec3,
+        area: f32,
+        radiance: impl FnOnce(Vec3) -> Vec3,
+    ) -> Option<LightSample> {
+        let to = p - from;
+        let d2 = to.length_squared();
+        if d2 == 0.0 || area == 0.0 {
+            return None;
+        }
+        let distance = d2.sqrt();
+        let wi = to * (1.0 / distance);
+        let cos_l = -wi.dot(n);
+        if cos_l <= 0.0 {
+            return None;
+        }
+        Some(LightSample {
+            radiance: radiance(wi),
+            wi,
+            distance,
+            pdf: d2 / (cos_l * area),
+            is_delta: false,
+            p_light: p,
+            n_light: n,
+        })
+    }
+}
+
 #[derive(Clone, Debug)]
 pub enum Light {
     Point(PointLight),

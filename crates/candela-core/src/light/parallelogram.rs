@@ -87,26 +87,7 @@ impl ParallelogramLight {
 
     pub fn sample_li(&self, ctx: &ShadingCtx, u: Vec2) -> Option<LightSample> {
         let p = self.p0 + self.e1 * u.x + self.e2 * u.y;
-        let to = p - ctx.p;
-        let d2 = to.length_squared();
-        if d2 == 0.0 {
-            return None;
-        }
-        let distance = d2.sqrt();
-        let wi = to * (1.0 / distance);
-        let cos_l = -wi.dot(self.n);
-        if cos_l <= 0.0 {
-            return None;
-        }
-        Some(LightSample {
-            radiance: self.le,
-            wi,
-            distance,
-            pdf: d2 / (cos_l * self.area),
-            is_delta: false,
-            p_light: p,
-            n_light: self.n,
-        })
+        LightSample::uniform_area(ctx.p, p, self.n, self.area, |_| self.le)
     }
 
     pub fn pdf_li(&self, ctx: &ShadingCtx, wi: Vec3) -> f32 {

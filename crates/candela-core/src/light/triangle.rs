@@ -63,26 +63,7 @@ impl TriangleLight {
     pub fn sample_li(&self, ctx: &ShadingCtx, u: Vec2) -> Option<LightSample> {
         let b = sample_uniform_triangle(u);
         let p = self.p[0] * b.x + self.p[1] * b.y + self.p[2] * b.z;
-        let to = p - ctx.p;
-        let d2 = to.length_squared();
-        if d2 == 0.0 || self.area == 0.0 {
-            return None;
-        }
-        let distance = d2.sqrt();
-        let wi = to * (1.0 / distance);
-        let cos_l = -wi.dot(self.n);
-        if cos_l <= 0.0 {
-            return None;
-        }
-        Some(LightSample {
-            radiance: self.emitted(-wi),
-            wi,
-            distance,
-            pdf: d2 / (cos_l * self.area),
-            is_delta: false,
-            p_light: p,
-            n_light: self.n,
-        })
+        LightSample::uniform_area(ctx.p, p, self.n, self.area, |wi| self.emitted(-wi))
     }
 
     pub fn pdf_li(&self, ctx: &ShadingCtx, wi: Vec3) -> f32 {

@@ -37,7 +37,7 @@ impl Glb {
 
     /// Appends bytes as a buffer view (4-byte aligned) and returns its index.
     pub fn view(&mut self, bytes: &[u8]) -> usize {
-        while self.bin.len() % 4 != 0 {
+        while !self.bin.len().is_multiple_of(4) {
             self.bin.push(0);
         }
         let offset = self.bin.len();
@@ -137,12 +137,12 @@ impl Glb {
     pub fn bytes(&self) -> Vec<u8> {
         let mut json = self.json.clone();
         let mut bin = self.bin.clone();
-        while bin.len() % 4 != 0 {
+        while !bin.len().is_multiple_of(4) {
             bin.push(0);
         }
         json["buffers"] = json!([{ "byteLength": self.bin.len() }]);
         let mut text = serde_json::to_vec(&json).unwrap();
-        while text.len() % 4 != 0 {
+        while !text.len().is_multiple_of(4) {
             text.push(b' ');
         }
         let total = 12 + 8 + text.len() + 8 + bin.len();
