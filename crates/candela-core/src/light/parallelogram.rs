@@ -1,5 +1,6 @@
 use glam::{Vec2, Vec3};
 
+use super::triangle::solid_angle;
 use super::{receiver_cos, LightBounds, LightSample, ShadingCtx, TriangleLight};
 use crate::geometry::Aabb;
 use crate::math::luminance;
@@ -138,12 +139,7 @@ impl ParallelogramLight {
         }
         let [a, b, c, d] = self.corners().map(|q| q - ctx.p);
         let (la, lb, lc, ld) = (a.length(), b.length(), c.length(), d.length());
-        let solid = |a: Vec3, b: Vec3, c: Vec3, la: f32, lb: f32, lc: f32| {
-            let num = a.dot(b.cross(c)).abs();
-            let den = la * lb * lc + a.dot(b) * lc + a.dot(c) * lb + b.dot(c) * la;
-            2.0 * num.atan2(den)
-        };
-        let omega = solid(a, b, c, la, lb, lc) + solid(a, c, d, la, lc, ld);
+        let omega = solid_angle([a, b, c], [la, lb, lc]) + solid_angle([a, c, d], [la, lc, ld]);
         let cos_r = [a / la, b / lb, c / lc, d / ld]
             .iter()
             .map(|w| receiver_cos(ctx, *w))

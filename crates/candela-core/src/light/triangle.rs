@@ -102,9 +102,7 @@ impl TriangleLight {
         }
         let [a, b, c] = self.p.map(|q| q - ctx.p);
         let (la, lb, lc) = (a.length(), b.length(), c.length());
-        let num = a.dot(b.cross(c)).abs();
-        let den = la * lb * lc + a.dot(b) * lc + a.dot(c) * lb + b.dot(c) * la;
-        let omega = 2.0 * num.atan2(den);
+        let omega = solid_angle([a, b, c], [la, lb, lc]);
         let cos_r = [a / la, b / lb, c / lc]
             .iter()
             .map(|w| receiver_cos(ctx, *w))
@@ -125,4 +123,13 @@ impl TriangleLight {
             two_sided: false,
         }
     }
+}
+
+/// Solid angle of the triangle with corners `v` relative to the viewer, whose lengths are
+/// `len` (Van Oosterom & Strackee 1983).
+pub(super) fn solid_angle(v: [Vec3; 3], len: [f32; 3]) -> f32 {
+    let ([a, b, c], [la, lb, lc]) = (v, len);
+    let num = a.dot(b.cross(c)).abs();
+    let den = la * lb * lc + a.dot(b) * lc + a.dot(c) * lb + b.dot(c) * la;
+    2.0 * num.atan2(den)
 }
