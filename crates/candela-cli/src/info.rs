@@ -24,11 +24,11 @@ pub fn run(path: &Path, load: &LoadArgs) -> Result<(), UserError> {
         println!("triangles  {}", scene.triangle_count());
     } else {
         println!(
-            "triangles  {} rendered, {} stored ({} instances of {} shared meshes)",
+            "triangles  {} rendered, {} stored ({} instances of {})",
             scene.triangle_count(),
             scene.stored_triangle_count(),
             scene.instances.instances.len(),
-            scene.instances.meshes.len()
+            shared_meshes(scene.instances.meshes.len())
         );
     }
     println!(
@@ -94,4 +94,9 @@ fn print_environment(env: &EnvironmentLight) {
         env.scene_radius,
         100.0 * env.peak_fraction(0.01)
     );
+}
+
+/// "1 shared mesh", "3 shared meshes".
+pub fn shared_meshes(n: usize) -> String {
+    format!("{n} shared mesh{}", if n == 1 { "" } else { "es" })
 }

@@ -277,9 +277,9 @@ pub fn run(args: RenderArgs) -> Result<ExitCode, UserError> {
     );
     if !scene.instances.is_empty() {
         println!(
-            "{} instances of {} shared meshes: {} triangles stored, {} rendered; built in {:.2} s",
+            "{} instances of {}: {} triangles stored, {} rendered; built in {:.2} s",
             scene.instances.instances.len(),
-            scene.instances.meshes.len(),
+            crate::info::shared_meshes(scene.instances.meshes.len()),
             scene.stored_triangle_count(),
             scene.triangle_count(),
             build_s

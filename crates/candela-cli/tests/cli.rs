@@ -165,7 +165,7 @@ instances = [[], [{{ translate = [-1, 0, 0] }}], [{{ translate = [0, -1, 0] }}]]
     let text = String::from_utf8_lossy(&o.stdout);
     // The base scene's 2 triangles, and 3 instances of 1.
     assert!(
-        text.contains("triangles  5 rendered, 3 stored (3 instances of 1 shared meshes)"),
+        text.contains("triangles  5 rendered, 3 stored (3 instances of 1 shared mesh)"),
         "{text}"
     );
     let out = dir.path().join("x.png");
@@ -173,7 +173,7 @@ instances = [[], [{{ translate = [-1, 0, 0] }}], [{{ translate = [0, -1, 0] }}]]
     assert!(o.status.success());
     let text = String::from_utf8_lossy(&o.stdout);
     assert!(
-        text.contains("3 instances of 1 shared meshes: 3 triangles stored, 5 rendered"),
+        text.contains("3 instances of 1 shared mesh: 3 triangles stored, 5 rendered"),
         "{text}"
     );
 }
