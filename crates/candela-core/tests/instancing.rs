@@ -17,6 +17,14 @@ fn uniform(state: &mut u64) -> f32 {
     (mix64(*state) >> 40) as f32 / (1u64 << 24) as f32
 }
 
+/// A uniform point of the cube [−h, h]³.
+fn uniform_in_cube(state: &mut u64, h: f32) -> Vec3 {
+    let x = uniform(state);
+    let y = uniform(state);
+    let z = uniform(state);
+    Vec3::new(x, y, z) * (2.0 * h) - h
+}
+
 /// A bumpy sphere of `2·rings·segments` triangles with normals, uvs and tangents, so that
 /// every attribute the hit record carries goes through the instance transform.
 fn bumpy_sphere(rings: u32, segments: u32) -> MeshDesc {
@@ -181,18 +189,8 @@ fn instanced_hits_equal_flattened_hits() {
     let (n, mut hits, mut edge_mismatch) = (40_000, 0, 0);
     let mut worst = 0.0f32;
     for _ in 0..n {
-        let o = Vec3::new(
-            uniform(&mut state),
-            uniform(&mut state),
-            uniform(&mut state),
-        ) * 30.0
-            - 15.0;
-        let target = Vec3::new(
-            uniform(&mut state),
-            uniform(&mut state),
-            uniform(&mut state),
-        ) * 20.0
-            - 10.0;
+        let o = uniform_in_cube(&mut state, 15.0);
+        let target = uniform_in_cube(&mut state, 10.0);
         // Not unit length, so a renormalised object-space direction would show in t.
         let ray = Ray::new(o, (target - o) * (0.3 + uniform(&mut state)));
         let (a, b) = (raw_hit(&inst, &ray), raw_hit(&flat, &ray));
@@ -432,18 +430,8 @@ fn alpha_masked_instances_cut_the_same_holes() {
     };
     let (n, mut hits, mut holes, mut differ) = (20_000, 0, 0, 0);
     for _ in 0..n {
-        let o = Vec3::new(
-            uniform(&mut state),
-            uniform(&mut state),
-            uniform(&mut state),
-        ) * 30.0
-            - 15.0;
-        let target = Vec3::new(
-            uniform(&mut state),
-            uniform(&mut state),
-            uniform(&mut state),
-        ) * 20.0
-            - 10.0;
+        let o = uniform_in_cube(&mut state, 15.0);
+        let target = uniform_in_cube(&mut state, 10.0);
         let ray = Ray::new(o, target - o);
         let (a, b) = (
             inst.intersect(&ray, f32::INFINITY),
