@@ -103,6 +103,18 @@ fn conductors_take_presets_or_eta_and_k_and_are_one_sided() {
         "{:?}",
         loaded.warnings
     );
+    // So is Mitsuba's default, which is beckmann; an explicit ggx is exact and silent.
+    for (body, warns) in [
+        (r#"<bsdf type="roughdielectric"/>"#, true),
+        (
+            r#"<bsdf type="roughconductor"><string name="distribution" value="ggx"/></bsdf>"#,
+            false,
+        ),
+    ] {
+        let loaded = load(&format!(r#"<shape type="cube">{body}</shape>"#));
+        let warned = loaded.warnings.iter().any(|w| w.contains("beckmann"));
+        assert_eq!(warned, warns, "{body}: {:?}", loaded.warnings);
+    }
     for (body, what) in [
         (
             r#"<bsdf type="conductor"><string name="material" value="W"/></bsdf>"#,

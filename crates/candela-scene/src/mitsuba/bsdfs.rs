@@ -238,20 +238,24 @@ fn roughness(ctx: &mut Ctx, node: &Node, rough: bool) -> Result<(f32, f32), Load
     if !rough {
         return Ok((0.0, 0.0));
     }
-    if let Some(d) = node.string("distribution")? {
-        match d {
-            "ggx" => {}
-            "beckmann" => ctx.warn(
-                node,
-                "Candela's microfacets are GGX: the beckmann distribution is rendered as \
-                 GGX of the same alpha",
-            ),
-            _ => {
-                let p = node.prop("distribution").expect("read just now");
-                return Err(p.error(format!(
-                    "unknown microfacet distribution \"{d}\" (ggx or beckmann)"
-                )));
-            }
+    // Mitsuba's default distribution is beckmann, so leaving it out asks for it too.
+    match node.string("distribution")? {
+        Some("ggx") => {}
+        None => ctx.warn(
+            node,
+            "Candela's microfacets are GGX: Mitsuba's default distribution, beckmann, is \
+             rendered as GGX of the same alpha (give distribution=\"ggx\" to match)",
+        ),
+        Some("beckmann") => ctx.warn(
+            node,
+            "Candela's microfacets are GGX: the beckmann distribution is rendered as GGX of \
+             the same alpha",
+        ),
+        Some(d) => {
+            let p = node.prop("distribution").expect("read just now");
+            return Err(p.error(format!(
+                "unknown microfacet distribution \"{d}\" (ggx or beckmann)"
+            )));
         }
     }
     // Candela always samples visible normals; the flag changes noise, not the image.
