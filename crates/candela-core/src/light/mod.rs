@@ -41,6 +41,7 @@ pub use triangle::TriangleLight;
 use glam::{Vec2, Vec3};
 
 use crate::geometry::Ray;
+use crate::math::luminance;
 
 /// Index of a light in [`crate::Scene::lights`].
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
@@ -61,6 +62,18 @@ fn receiver_cos(ctx: &ShadingCtx, w: Vec3) -> f32 {
     } else {
         ctx.n.dot(w).abs()
     }
+}
+
+/// Importance of a flat one-sided emitter of radiance `le` that subtends `omega` from the
+/// shading point, seen along the unit directions `corners` to its corners: luminance ×
+/// solid angle × the largest receiver cosine over the corners. A tiny floor on the solid
+/// angle keeps grazing but still visible emitters selectable.
+fn flat_importance(ctx: &ShadingCtx, le: Vec3, omega: f32, corners: &[Vec3]) -> f32 {
+    let cos_r = corners
+        .iter()
+        .map(|w| receiver_cos(ctx, *w))
+        .fold(0.0f32, f32::max);
+    luminance(le) * omega.max(1e-12) * cos_r
 }
 
 /// A sampled direction towards a light.

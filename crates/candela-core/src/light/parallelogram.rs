@@ -1,7 +1,7 @@
 use glam::{Vec2, Vec3};
 
 use super::triangle::solid_angle;
-use super::{receiver_cos, LightBounds, LightSample, ShadingCtx, TriangleLight};
+use super::{flat_importance, LightBounds, LightSample, ShadingCtx, TriangleLight};
 use crate::geometry::Aabb;
 use crate::math::luminance;
 
@@ -140,11 +140,7 @@ impl ParallelogramLight {
         let [a, b, c, d] = self.corners().map(|q| q - ctx.p);
         let (la, lb, lc, ld) = (a.length(), b.length(), c.length(), d.length());
         let omega = solid_angle([a, b, c], [la, lb, lc]) + solid_angle([a, c, d], [la, lc, ld]);
-        let cos_r = [a / la, b / lb, c / lc, d / ld]
-            .iter()
-            .map(|w| receiver_cos(ctx, *w))
-            .fold(0.0f32, f32::max);
-        luminance(self.le) * omega.max(1e-12) * cos_r
+        flat_importance(ctx, self.le, omega, &[a / la, b / lb, c / lc, d / ld])
     }
 
     /// One-sided Lambertian emitter: normal cone of zero width, emission up to 90°;

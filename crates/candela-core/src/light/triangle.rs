@@ -2,7 +2,7 @@ use std::f32::consts::PI;
 
 use glam::{Vec2, Vec3};
 
-use super::{receiver_cos, LightBounds, LightProfile, LightSample, ShadingCtx};
+use super::{flat_importance, LightBounds, LightProfile, LightSample, ShadingCtx};
 use crate::geometry::Aabb;
 use crate::geometry::{Ray, WatertightRay};
 use crate::math::luminance;
@@ -103,12 +103,7 @@ impl TriangleLight {
         let [a, b, c] = self.p.map(|q| q - ctx.p);
         let (la, lb, lc) = (a.length(), b.length(), c.length());
         let omega = solid_angle([a, b, c], [la, lb, lc]);
-        let cos_r = [a / la, b / lb, c / lc]
-            .iter()
-            .map(|w| receiver_cos(ctx, *w))
-            .fold(0.0f32, f32::max);
-        // A tiny floor keeps grazing but still visible triangles selectable.
-        luminance(self.le) * omega.max(1e-12) * cos_r
+        flat_importance(ctx, self.le, omega, &[a / la, b / lb, c / lc])
     }
 
     /// One-sided Lambertian emitter: normal cone of zero width, emission up to 90°;
