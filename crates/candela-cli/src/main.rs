@@ -1,7 +1,8 @@
 //! `candela`: render scenes from the command line.
 //!
 //! Exit codes: 0 success, 2 bad input or a failed write (one line on stderr naming the
-//! file and what is wrong), 130 interrupted (the partial image is still written), 101 an
+//! file and what is wrong), 130 interrupted by Ctrl-C and 143 by
+//! SIGTERM (the partial image is still written), 101 an
 //! internal bug.
 
 mod ies;

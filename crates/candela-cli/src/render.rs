@@ -6,7 +6,8 @@
 
 use std::path::PathBuf;
 use std::process::ExitCode;
-use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
+use std::sync::Arc;
 use std::time::Instant;
 
 use candela_core::desc::{
@@ -16,6 +17,8 @@ use candela_core::desc::{
 use candela_core::integrator;
 use clap::Args;
 use indicatif::{ProgressBar, ProgressStyle};
+use signal_hook::consts::{SIGINT, SIGTERM};
+use signal_hook::flag;
 
 use crate::output::{write_image, ImageFormat, LinearImage};
 use crate::tonemap::{DisplayTransform, Tonemap};
@@ -208,16 +211,39 @@ impl RenderArgs {
     }
 }
 
-static CANCEL: AtomicBool = AtomicBool::new(false);
+/// What the interrupt handlers share with the render: whether to stop, and which signal
+/// asked for it.
+struct Interrupt {
+    cancel: Arc<AtomicBool>,
+    signal: Arc<AtomicUsize>,
+}
 
-fn install_interrupt_handler() {
-    // A second interrupt while the first is being honoured exits at once.
-    let _ = ctrlc::set_handler(|| {
-        if CANCEL.swap(true, Ordering::SeqCst) {
-            eprintln!("\ncandela: interrupted again, exiting without writing");
-            std::process::exit(130);
+impl Interrupt {
+    /// Ctrl-C (SIGINT) or SIGTERM: the first stops the render at its next work item, so
+    /// that what it has is written; a second exits at once, writing nothing. Either way
+    /// the exit status is the shell's for that signal, 128 + its number (130, 143).
+    fn install() -> Result<Interrupt, UserError> {
+        let cancel = Arc::new(AtomicBool::new(false));
+        let signal = Arc::new(AtomicUsize::new(0));
+        let register = |sig: i32| -> std::io::Result<()> {
+            // Handlers run in the order they were registered: the conditional exit sees
+            // `cancel` before this signal sets it, so only a second signal exits.
+            flag::register_conditional_shutdown(sig, 128 + sig, Arc::clone(&cancel))?;
+            flag::register(sig, Arc::clone(&cancel))?;
+            flag::register_usize(sig, Arc::clone(&signal), sig as usize)?;
+            Ok(())
+        };
+        for sig in [SIGINT, SIGTERM] {
+            register(sig).map_err(|e| UserError(format!("cannot handle signal {sig}: {e}")))?;
         }
-    });
+        Ok(Interrupt { cancel, signal })
+    }
+
+    /// The exit status of a render that the signal stopped.
+    fn exit_code(&self) -> ExitCode {
+        let sig = self.signal.load(Ordering::SeqCst);
+        ExitCode::from(u8::try_from(128 + sig).unwrap_or(130))
+    }
 }
 
 pub fn run(args: RenderArgs) -> Result<ExitCode, UserError> {
@@ -236,7 +262,7 @@ pub fn run(args: RenderArgs) -> Result<ExitCode, UserError> {
         .num_threads(threads)
         .build()
         .map_err(|e| UserError(format!("cannot start {threads} threads: {e}")))?;
-    install_interrupt_handler();
+    let interrupt = Interrupt::install()?;
 
     let total = s.width as u64 * s.height as u64 * s.spp as u64;
     let bar = ProgressBar::new(total);
@@ -247,7 +273,8 @@ pub fn run(args: RenderArgs) -> Result<ExitCode, UserError> {
         .expect("valid progress template"),
     );
     let start = Instant::now();
-    let result = pool.install(|| integrator::render(&scene, 0..s.spp, &CANCEL, &|n| bar.inc(n)));
+    let result =
+        pool.install(|| integrator::render(&scene, 0..s.spp, &interrupt.cancel, &|n| bar.inc(n)));
     let elapsed = start.elapsed().as_secs_f64();
     bar.finish_and_clear();
 
@@ -296,7 +323,7 @@ pub fn run(args: RenderArgs) -> Result<ExitCode, UserError> {
             100.0 * done,
             args.output.display()
         );
-        return Ok(ExitCode::from(130));
+        return Ok(interrupt.exit_code());
     }
     Ok(ExitCode::SUCCESS)
 }

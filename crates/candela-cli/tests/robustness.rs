@@ -124,8 +124,8 @@ fn an_internal_error_exits_101_and_asks_for_a_report() {
 }
 
 /// Sends `signal` to a long render and checks that the previous file was replaced by a
-/// whole partial image, atomically.
-fn a_signal_writes_the_partial_image_atomically(signal: &str) {
+/// whole partial image, atomically, and exited with the shell's `status` for it.
+fn a_signal_writes_the_partial_image_atomically(signal: &str, status: i32) {
     let (dir, scene) = scene_with("", &[]);
     let out = dir.path().join("partial.pfm");
     std::fs::write(&out, b"previous image").unwrap();
@@ -152,7 +152,7 @@ fn a_signal_writes_the_partial_image_atomically(signal: &str) {
     assert!(killed.success());
     let o = child.wait_with_output().unwrap();
     let err = String::from_utf8_lossy(&o.stderr);
-    assert_eq!(o.status.code(), Some(130), "{err}");
+    assert_eq!(o.status.code(), Some(status), "{err}");
     assert!(err.contains("partial image"), "{err}");
     // A whole image replaced the old file: header, exactly 24·16·3 floats, all finite.
     let bytes = std::fs::read(&out).unwrap();
@@ -179,13 +179,13 @@ fn a_signal_writes_the_partial_image_atomically(signal: &str) {
 #[cfg(unix)]
 #[test]
 fn sigterm_writes_the_partial_image_atomically() {
-    a_signal_writes_the_partial_image_atomically("-TERM");
+    a_signal_writes_the_partial_image_atomically("-TERM", 143);
 }
 
 #[cfg(unix)]
 #[test]
 fn ctrl_c_writes_the_partial_image_atomically() {
-    a_signal_writes_the_partial_image_atomically("-INT");
+    a_signal_writes_the_partial_image_atomically("-INT", 130);
 }
 
 /// Whether this process runs as root (for whom a read-only folder is still writable).
