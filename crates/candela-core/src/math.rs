@@ -13,6 +13,7 @@ pub struct Frame {
 impl Frame {
     /// A frame around the unit vector `n`, after Duff et al. 2017, "Building an
     /// Orthonormal Basis, Revisited" (branchless, no singularity).
+    #[inline]
     pub fn from_z(n: Vec3) -> Frame {
         let sign = 1.0f32.copysign(n.z);
         let a = -1.0 / (sign + n.z);
@@ -22,16 +23,19 @@ impl Frame {
         Frame { s, t, n }
     }
 
+    #[inline]
     pub fn to_local(&self, v: Vec3) -> Vec3 {
         Vec3::new(v.dot(self.s), v.dot(self.t), v.dot(self.n))
     }
 
+    #[inline]
     pub fn to_world(&self, v: Vec3) -> Vec3 {
         self.s * v.x + self.t * v.y + self.n * v.z
     }
 }
 
 /// Relative luminance of a linear Rec.709 colour (ITU-R BT.709 weights).
+#[inline]
 pub fn luminance(c: Vec3) -> f32 {
     0.2126 * c.x + 0.7152 * c.y + 0.0722 * c.z
 }
@@ -41,6 +45,7 @@ pub fn luminance(c: Vec3) -> f32 {
 /// Binder, "A Fast and Robust Method for Avoiding Self-Intersection", Ray Tracing Gems
 /// ch. 6: integer ulp steps far from the origin, a small float step near it. `n` is a unit
 /// vector (each |n_i| ≤ 1).
+#[inline]
 pub fn offset_ray_origin(p: Vec3, n: Vec3) -> Vec3 {
     const ORIGIN: f32 = 1.0 / 32.0;
     const FLOAT_SCALE: f32 = 1.0 / 65536.0;
@@ -78,6 +83,7 @@ pub fn is_black(c: Vec3) -> bool {
 }
 
 /// Largest channel of a colour.
+#[inline]
 pub fn max_component(c: Vec3) -> f32 {
     c.x.max(c.y).max(c.z)
 }

@@ -15,6 +15,7 @@ pub struct Diffuse {
 }
 
 impl Diffuse {
+    #[inline]
     pub fn f(&self, wo: Vec3, wi: Vec3) -> Vec3 {
         if wo.z * wi.z <= 0.0 {
             return Vec3::ZERO;
@@ -22,6 +23,7 @@ impl Diffuse {
         self.albedo * FRAC_1_PI
     }
 
+    #[inline]
     pub fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
         if wo.z * wi.z <= 0.0 {
             return 0.0;
@@ -29,6 +31,17 @@ impl Diffuse {
         cosine_hemisphere_pdf(wi.z.abs())
     }
 
+    /// [`Self::f`] times |cos θᵢ|, and [`Self::pdf`].
+    #[inline]
+    pub fn f_cos_pdf(&self, wo: Vec3, wi: Vec3) -> (Vec3, f32) {
+        if wo.z * wi.z <= 0.0 {
+            return (Vec3::ZERO, 0.0);
+        }
+        let cos = wi.z.abs();
+        (self.albedo * FRAC_1_PI * cos, cosine_hemisphere_pdf(cos))
+    }
+
+    #[inline]
     pub fn sample(&self, wo: Vec3, _u_lobe: f32, u: Vec2) -> Option<BsdfSample> {
         let mut wi = sample_cosine_hemisphere(u);
         if wo.z < 0.0 {

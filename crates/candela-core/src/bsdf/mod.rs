@@ -92,12 +92,14 @@ pub enum Lobe {
 }
 
 /// Mirrors a direction through the surface plane (z → −z).
+#[inline]
 fn flip_z(w: Vec3) -> Vec3 {
     Vec3::new(w.x, w.y, -w.z)
 }
 
 impl Lobe {
     /// Reflection-only lobes, evaluated in the hemisphere of `wo` (two-sided).
+    #[inline]
     fn reflective_f(&self, wo: Vec3, wi: Vec3) -> Vec3 {
         match self {
             Lobe::Diffuse(l) => l.f(wo, wi),
@@ -108,6 +110,7 @@ impl Lobe {
         }
     }
 
+    #[inline]
     pub fn f(&self, wo: Vec3, wi: Vec3) -> Vec3 {
         match self {
             Lobe::Dielectric(l) => l.f(wo, wi),
@@ -117,6 +120,7 @@ impl Lobe {
         }
     }
 
+    #[inline]
     pub fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
         let (wo, wi) = if wo.z < 0.0 && self.is_reflective() {
             (flip_z(wo), flip_z(wi))
@@ -133,6 +137,7 @@ impl Lobe {
         }
     }
 
+    #[inline]
     pub fn sample(&self, wo: Vec3, u_lobe: f32, u: Vec2) -> Option<BsdfSample> {
         let flip = wo.z < 0.0 && self.is_reflective();
         let wo = if flip { flip_z(wo) } else { wo };
@@ -156,10 +161,12 @@ impl Lobe {
 
     /// Whether [`Self::sample`] reads `u_lobe` (the lambertian and conductor lobes have
     /// one component and ignore it).
+    #[inline]
     pub fn takes_lobe_sample(&self) -> bool {
         !matches!(self, Lobe::Diffuse(_) | Lobe::Conductor(_))
     }
 
+    #[inline]
     fn is_reflective(&self) -> bool {
         !matches!(self, Lobe::Dielectric(_) | Lobe::ThinDielectric(_))
     }
@@ -167,6 +174,7 @@ impl Lobe {
     /// Whether every component is a delta (then NEE is pointless). Plastic is not: its
     /// coat is a delta but its base is diffuse, and NEE goes through `f`/`pdf`, which
     /// hold only the diffuse part.
+    #[inline]
     pub fn is_delta(&self) -> bool {
         match self {
             Lobe::Diffuse(_) | Lobe::Plastic(_) | Lobe::MetalRough(_) => false,
@@ -190,6 +198,7 @@ pub struct Bsdf {
 }
 
 impl Bsdf {
+    #[inline]
     pub fn new(ns: Vec3, ng: Vec3, lobe: Lobe) -> Bsdf {
         Bsdf {
             frame: Frame::from_z(ns),
@@ -221,6 +230,7 @@ impl Bsdf {
 
     /// Whether the geometric normal agrees with the shading frame on reflection versus
     /// transmission for this pair (see the module's conventions on light leaks).
+    #[inline]
     fn sides_agree(&self, wo: Vec3, wi: Vec3, lo: Vec3, li: Vec3) -> bool {
         let geometric_reflection = wo.dot(self.ng) * wi.dot(self.ng) > 0.0;
         let shading_reflection = lo.z * li.z > 0.0;
@@ -228,6 +238,7 @@ impl Bsdf {
     }
 
     /// Whether `wo` (local) sees nothing: grazing, or the back of a one-sided BSDF.
+    #[inline]
     fn blind(&self, lo: Vec3) -> bool {
         lo.z == 0.0 || (self.one_sided && lo.z < 0.0)
     }
@@ -250,20 +261,30 @@ impl Bsdf {
 
     /// [`Self::f`] times |cos θᵢ|, and [`Self::pdf`], of one pair of directions: what next
     /// event estimation asks for, with one change of frame instead of three.
+    #[inline]
     pub fn f_cos_pdf(&self, wo: Vec3, wi: Vec3) -> (Vec3, f32) {
         let (lo, li) = (self.frame.to_local(wo), self.frame.to_local(wi));
         if self.blind(lo) || !self.sides_agree(wo, wi, lo, li) {
             return (Vec3::ZERO, 0.0);
         }
+        if let Lobe::Diffuse(d) = &self.lobe {
+            // `Lobe::f` and `Lobe::pdf` of the two-sided Lambertian lobe, one dispatch.
+            return d.f_cos_pdf(lo, li);
+        }
         (self.lobe.f(lo, li) * li.z.abs(), self.lobe.pdf(lo, li))
     }
 
+    #[inline]
     pub fn sample(&self, wo: Vec3, u_lobe: f32, u: Vec2) -> Option<BsdfSample> {
         let lo = self.frame.to_local(wo);
         if self.blind(lo) {
             return None;
         }
-        let s = self.lobe.sample(lo, u_lobe, u)?;
+        let s = match &self.lobe {
+            // Two-sided already: no mirroring of `wo` and back.
+            Lobe::Diffuse(d) => d.sample(lo, u_lobe, u),
+            lobe => lobe.sample(lo, u_lobe, u),
+        }?;
         if s.pdf == 0.0 || !s.pdf.is_finite() || s.wi.z == 0.0 || !s.f.is_finite() {
             return None;
         }
@@ -274,11 +295,13 @@ impl Bsdf {
         Some(BsdfSample { wi, ..s })
     }
 
+    #[inline]
     pub fn is_delta(&self) -> bool {
         self.lobe.is_delta()
     }
 
     /// |cos θ| of `wi` against the shading normal.
+    #[inline]
     pub fn abs_cos(&self, wi: Vec3) -> f32 {
         wi.dot(self.frame.n).abs()
     }

@@ -86,6 +86,7 @@ impl LightSampler {
 
     /// Picks a light at `ctx` from one uniform number `u`; `None` where no light can
     /// contribute. `lights` must be the slice the sampler was built from.
+    #[inline]
     pub fn sample(&self, ctx: &ShadingCtx, u: f32, lights: &[Light]) -> Option<LightPick> {
         let pick = |id: u32, pmf: f32| LightPick {
             id: LightId(id),
@@ -113,6 +114,7 @@ impl LightSampler {
 
     /// Probability that [`Self::sample`] picks `light` at `ctx`, as MIS uses it: exact
     /// for every sampler but RIS, whose surrogate is explained in [`ris`].
+    #[inline]
     pub fn pmf(&self, ctx: &ShadingCtx, light: LightId) -> f32 {
         match self {
             LightSampler::Empty => 0.0,
