@@ -90,7 +90,7 @@ impl Material {
         }
     }
 
-    #[inline]
+    #[inline(always)]
     fn lobe(&self, uv: Vec2, color: Vec3) -> Lobe {
         match self {
             Material::Diffuse { albedo } => Lobe::Diffuse(Diffuse {

@@ -271,6 +271,7 @@ impl Scene {
         !self.occluded(&Ray::new(o, d), f32::INFINITY)
     }
 
+    #[inline]
     fn interaction(&self, ray: &Ray, prim: Prim, t: f32, bary: Vec2) -> SurfaceInteraction {
         match prim {
             Prim::Triangle { mesh, tri } => {
@@ -308,6 +309,7 @@ impl Scene {
 /// The hit record of triangle `tri` of `m` at barycentrics `bary`: a world-space mesh's
 /// where `inst` is `None`, else an instance's, whose object-space vertex data is carried to
 /// world space first by the same [`crate::instance::Transform`] that flattens meshes.
+#[inline]
 fn triangle_interaction(
     m: &Mesh,
     inst: Option<&Instance>,
@@ -396,7 +398,7 @@ fn full_triangle_interaction(
 /// tangents or colours, the Cornell box's walls): the same record, without the branches
 /// and interpolations of the attributes it lacks. The uvs are the barycentrics, ∂p/∂u is
 /// p₁ − p₀, as in the general case.
-#[inline]
+#[inline(always)]
 fn bare_triangle_interaction(m: &Mesh, tri: u32, t: f32, bary: Vec2) -> SurfaceInteraction {
     let [p0, p1, p2] = m.vertices(tri);
     let b0 = 1.0 - bary.x - bary.y;

@@ -230,22 +230,24 @@ impl Bsdf {
 
     /// Whether the geometric normal agrees with the shading frame on reflection versus
     /// transmission for this pair (see the module's conventions on light leaks).
-    #[inline]
-    fn sides_agree(&self, wo: Vec3, wi: Vec3, lo: Vec3, li: Vec3) -> bool {
+    #[inline(always)]
+    /// `cos_o` and `cos_i` are the local z of `wo` and `wi` (their shading cosines).
+    fn sides_agree(&self, wo: Vec3, wi: Vec3, cos_o: f32, cos_i: f32) -> bool {
         let geometric_reflection = wo.dot(self.ng) * wi.dot(self.ng) > 0.0;
-        let shading_reflection = lo.z * li.z > 0.0;
+        let shading_reflection = cos_o * cos_i > 0.0;
         geometric_reflection == shading_reflection
     }
 
-    /// Whether `wo` (local) sees nothing: grazing, or the back of a one-sided BSDF.
-    #[inline]
-    fn blind(&self, lo: Vec3) -> bool {
-        lo.z == 0.0 || (self.one_sided && lo.z < 0.0)
+    /// Whether `wo`, of shading cosine `cos_o`, sees nothing: grazing, or the back of a
+    /// one-sided BSDF.
+    #[inline(always)]
+    fn blind(&self, cos_o: f32) -> bool {
+        cos_o == 0.0 || (self.one_sided && cos_o < 0.0)
     }
 
     pub fn f(&self, wo: Vec3, wi: Vec3) -> Vec3 {
         let (lo, li) = (self.frame.to_local(wo), self.frame.to_local(wi));
-        if self.blind(lo) || !self.sides_agree(wo, wi, lo, li) {
+        if self.blind(lo.z) || !self.sides_agree(wo, wi, lo.z, li.z) {
             return Vec3::ZERO;
         }
         self.lobe.f(lo, li)
@@ -253,7 +255,7 @@ impl Bsdf {
 
     pub fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
         let (lo, li) = (self.frame.to_local(wo), self.frame.to_local(wi));
-        if self.blind(lo) || !self.sides_agree(wo, wi, lo, li) {
+        if self.blind(lo.z) || !self.sides_agree(wo, wi, lo.z, li.z) {
             return 0.0;
         }
         self.lobe.pdf(lo, li)
@@ -263,33 +265,54 @@ impl Bsdf {
     /// event estimation asks for, with one change of frame instead of three.
     #[inline]
     pub fn f_cos_pdf(&self, wo: Vec3, wi: Vec3) -> (Vec3, f32) {
-        let (lo, li) = (self.frame.to_local(wo), self.frame.to_local(wi));
-        if self.blind(lo) || !self.sides_agree(wo, wi, lo, li) {
-            return (Vec3::ZERO, 0.0);
-        }
         if let Lobe::Diffuse(d) = &self.lobe {
-            // `Lobe::f` and `Lobe::pdf` of the two-sided Lambertian lobe, one dispatch.
-            return d.f_cos_pdf(lo, li);
+            // The Lambertian lobe reads only the two cosines: two dot products instead of
+            // two changes of frame, and one dispatch instead of two.
+            let (cos_o, cos_i) = (wo.dot(self.frame.n), wi.dot(self.frame.n));
+            if self.blind(cos_o) || !self.sides_agree(wo, wi, cos_o, cos_i) {
+                return (Vec3::ZERO, 0.0);
+            }
+            return d.f_cos_pdf(cos_o, cos_i);
+        }
+        let (lo, li) = (self.frame.to_local(wo), self.frame.to_local(wi));
+        if self.blind(lo.z) || !self.sides_agree(wo, wi, lo.z, li.z) {
+            return (Vec3::ZERO, 0.0);
         }
         (self.lobe.f(lo, li) * li.z.abs(), self.lobe.pdf(lo, li))
     }
 
     #[inline]
     pub fn sample(&self, wo: Vec3, u_lobe: f32, u: Vec2) -> Option<BsdfSample> {
-        let lo = self.frame.to_local(wo);
-        if self.blind(lo) {
-            return None;
-        }
-        let s = match &self.lobe {
-            // Two-sided already: no mirroring of `wo` and back.
-            Lobe::Diffuse(d) => d.sample(lo, u_lobe, u),
-            lobe => lobe.sample(lo, u_lobe, u),
-        }?;
-        if s.pdf == 0.0 || !s.pdf.is_finite() || s.wi.z == 0.0 || !s.f.is_finite() {
-            return None;
-        }
+        let (cos_o, s) = match &self.lobe {
+            // The Lambertian lobe reads only the cosine of `wo` (one dot product, not a
+            // change of frame) and is two-sided already (no mirroring of `wo` and back).
+            Lobe::Diffuse(d) => {
+                let cos_o = wo.dot(self.frame.n);
+                if self.blind(cos_o) {
+                    return None;
+                }
+                let s = d.sample_from(cos_o, u)?;
+                // Its pdf, |cos θᵢ|/π, is positive (or no sample) and finite, so wi.z ≠ 0:
+                // only f is left to check.
+                if !s.f.is_finite() {
+                    return None;
+                }
+                (cos_o, s)
+            }
+            lobe => {
+                let lo = self.frame.to_local(wo);
+                if self.blind(lo.z) {
+                    return None;
+                }
+                let s = lobe.sample(lo, u_lobe, u)?;
+                if s.pdf == 0.0 || !s.pdf.is_finite() || s.wi.z == 0.0 || !s.f.is_finite() {
+                    return None;
+                }
+                (lo.z, s)
+            }
+        };
         let wi = self.frame.to_world(s.wi);
-        if !self.sides_agree(wo, wi, lo, s.wi) {
+        if !self.sides_agree(wo, wi, cos_o, s.wi.z) {
             return None;
         }
         Some(BsdfSample { wi, ..s })
