@@ -71,6 +71,7 @@ impl Material {
     /// The BSDF at a surface interaction: its shading frame (tangent `dpdu`, bitangent
     /// sign), uvs, and vertex colour multiplying the base colour (diffuse and plastic
     /// albedo, metal_rough base colour; other lobes ignore it).
+    #[inline]
     pub fn bsdf_at(&self, si: &SurfaceInteraction) -> Bsdf {
         match self {
             Material::NormalMap { map, inner } => {
@@ -89,6 +90,7 @@ impl Material {
         }
     }
 
+    #[inline(always)]
     fn lobe(&self, uv: Vec2, color: Vec3) -> Lobe {
         match self {
             Material::Diffuse { albedo } => Lobe::Diffuse(Diffuse {

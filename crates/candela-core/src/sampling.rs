@@ -11,6 +11,7 @@ use glam::{Vec2, Vec3};
 
 /// Shirley–Chiu concentric map from the square to the unit disk (area-preserving up to
 /// the factor π).
+#[inline]
 pub fn sample_concentric_disk(u: Vec2) -> Vec2 {
     let o = 2.0 * u - Vec2::ONE;
     if o == Vec2::ZERO {
@@ -42,6 +43,7 @@ pub fn sin_cos_quarter(a: f32) -> (f32, f32) {
 }
 
 /// Cosine-weighted direction on the hemisphere around +z (Malley's method).
+#[inline]
 pub fn sample_cosine_hemisphere(u: Vec2) -> Vec3 {
     let d = sample_concentric_disk(u);
     let z = (1.0 - d.length_squared()).max(0.0).sqrt();
@@ -49,6 +51,7 @@ pub fn sample_cosine_hemisphere(u: Vec2) -> Vec3 {
 }
 
 /// Density of [`sample_cosine_hemisphere`] in solid angle.
+#[inline]
 pub fn cosine_hemisphere_pdf(cos_theta: f32) -> f32 {
     cos_theta.max(0.0) * FRAC_1_PI
 }
@@ -91,6 +94,7 @@ pub fn sample_uniform_triangle(u: Vec2) -> Vec3 {
 }
 
 /// Balance heuristic weight of strategy `f` against strategy `g` (one sample each).
+#[inline]
 pub fn balance_heuristic(pdf_f: f32, pdf_g: f32) -> f32 {
     if pdf_f == 0.0 {
         return 0.0;
@@ -99,6 +103,7 @@ pub fn balance_heuristic(pdf_f: f32, pdf_g: f32) -> f32 {
 }
 
 /// Power heuristic (β = 2) weight of strategy `f` against strategy `g`.
+#[inline]
 pub fn power_heuristic(pdf_f: f32, pdf_g: f32) -> f32 {
     if pdf_f == 0.0 {
         return 0.0;

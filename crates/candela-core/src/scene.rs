@@ -49,12 +49,22 @@ impl Mesh {
 
     /// Texture coordinates at barycentrics (b1, b2) of a triangle (the barycentrics
     /// themselves where the mesh has no uvs, as [`Scene::intersect`] reports them).
+    #[inline]
     pub fn uv_at(&self, tri: u32, bary: Vec2) -> Vec2 {
         if self.uvs.is_empty() {
             return bary;
         }
         let [a, b, c] = self.indices[tri as usize].map(|i| i as usize);
         self.uvs[a] * (1.0 - bary.x - bary.y) + self.uvs[b] * bary.x + self.uvs[c] * bary.y
+    }
+
+    /// Whether the mesh has positions only: no normals, uvs, tangents or colours.
+    #[inline]
+    pub fn is_bare(&self) -> bool {
+        self.normals.is_empty()
+            && self.uvs.is_empty()
+            && self.tangents.is_empty()
+            && self.colors.is_empty()
     }
 
     /// Unit geometric normal of a triangle: from the winding, turned towards the shading
@@ -70,6 +80,7 @@ impl Mesh {
 
 /// The unit normal of the winding of `p`, turned towards `normals` (the sum of the
 /// vertices' shading normals) where given, and flipped by `flip`.
+#[inline]
 fn winding_normal(p: [Vec3; 3], normals: Option<Vec3>, flip: bool) -> Vec3 {
     let [p0, p1, p2] = p;
     let mut n = (p1 - p0).cross(p2 - p0).normalize_or_zero();
@@ -127,6 +138,7 @@ pub struct SurfaceInteraction {
 
 impl SurfaceInteraction {
     /// A ray leaving this surface towards `d`, its origin moved off the surface.
+    #[inline]
     pub fn spawn_ray(&self, d: Vec3) -> Ray {
         let n = if d.dot(self.ng) >= 0.0 {
             self.ng
@@ -176,6 +188,7 @@ impl Scene {
         self.meshes.iter().map(|m| m.indices.len()).sum()
     }
 
+    #[inline]
     pub fn light(&self, id: LightId) -> &Light {
         &self.lights[id.0 as usize]
     }
@@ -206,6 +219,7 @@ impl Scene {
     }
 
     /// Whether anything lies on the ray within (0, t_max).
+    #[inline]
     pub fn occluded(&self, ray: &Ray, t_max: f32) -> bool {
         self.accel
             .occluded(ray, t_max, |i, hit| self.alpha_accepts(i, hit, ray))
@@ -218,6 +232,7 @@ impl Scene {
     /// Whether the segment from surface point `from` (normal `n_from`) to point `to`
     /// (normal `n_to`, zero for a point light) is unblocked. Both ends are moved off their
     /// surfaces so that neither surface blocks its own ray.
+    #[inline]
     pub fn unoccluded(&self, from: Vec3, n_from: Vec3, to: Vec3, n_to: Vec3) -> bool {
         let d = to - from;
         let o = offset_ray_origin(
@@ -243,6 +258,7 @@ impl Scene {
     }
 
     /// Whether a ray leaving `from` towards `d` escapes the scene.
+    #[inline]
     pub fn escapes(&self, from: Vec3, n_from: Vec3, d: Vec3) -> bool {
         let o = offset_ray_origin(
             from,
@@ -255,6 +271,7 @@ impl Scene {
         !self.occluded(&Ray::new(o, d), f32::INFINITY)
     }
 
+    #[inline]
     fn interaction(&self, ray: &Ray, prim: Prim, t: f32, bary: Vec2) -> SurfaceInteraction {
         match prim {
             Prim::Triangle { mesh, tri } => {
@@ -292,7 +309,23 @@ impl Scene {
 /// The hit record of triangle `tri` of `m` at barycentrics `bary`: a world-space mesh's
 /// where `inst` is `None`, else an instance's, whose object-space vertex data is carried to
 /// world space first by the same [`crate::instance::Transform`] that flattens meshes.
+#[inline]
 fn triangle_interaction(
+    m: &Mesh,
+    inst: Option<&Instance>,
+    tri: u32,
+    t: f32,
+    bary: Vec2,
+) -> SurfaceInteraction {
+    if inst.is_none() && m.is_bare() {
+        bare_triangle_interaction(m, tri, t, bary)
+    } else {
+        full_triangle_interaction(m, inst, tri, t, bary)
+    }
+}
+
+/// [`triangle_interaction`] with every vertex attribute the mesh has interpolated.
+fn full_triangle_interaction(
     m: &Mesh,
     inst: Option<&Instance>,
     tri: u32,
@@ -361,6 +394,29 @@ fn triangle_interaction(
     }
 }
 
+/// [`triangle_interaction`] of a world-space mesh with positions only (no normals, uvs,
+/// tangents or colours, the Cornell box's walls): the same record, without the branches
+/// and interpolations of the attributes it lacks. The uvs are the barycentrics, ∂p/∂u is
+/// p₁ − p₀, as in the general case.
+#[inline(always)]
+fn bare_triangle_interaction(m: &Mesh, tri: u32, t: f32, bary: Vec2) -> SurfaceInteraction {
+    let [p0, p1, p2] = m.vertices(tri);
+    let b0 = 1.0 - bary.x - bary.y;
+    let ng = winding_normal([p0, p1, p2], None, m.flip_normals);
+    SurfaceInteraction {
+        p: p0 * b0 + p1 * bary.x + p2 * bary.y,
+        t,
+        ng,
+        ns: ng,
+        uv: bary,
+        dpdu: p1 - p0,
+        bitangent_sign: 1.0,
+        color: Vec3::ONE,
+        material: m.material,
+        light: m.lights.get(tri as usize).copied(),
+    }
+}
+
 /// ∂p/∂u and ∂p/∂v of a triangle from its positions and uvs (pbrt-v4 §6.5.3); zero when
 /// the uvs are degenerate.
 fn triangle_dpdu_dpdv(p: [Vec3; 3], uv: [Vec2; 3]) -> (Vec3, Vec3) {
@@ -376,5 +432,44 @@ fn triangle_dpdu_dpdv(p: [Vec3; 3], uv: [Vec2; 3]) -> (Vec3, Vec3) {
         (dpdu, dpdv)
     } else {
         (Vec3::ZERO, Vec3::ZERO)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_bare_mesh_s_fast_hit_record_is_the_full_one() {
+        let mut m = Mesh {
+            positions: vec![
+                Vec3::new(0.1, 0.2, 0.3),
+                Vec3::new(1.7, -0.4, 0.2),
+                Vec3::new(0.3, 1.1, -0.9),
+                Vec3::new(-0.5, 0.6, 2.0),
+            ],
+            normals: vec![],
+            uvs: vec![],
+            colors: vec![],
+            tangents: vec![],
+            indices: vec![[0, 1, 2], [2, 1, 3]],
+            material: MaterialId(3),
+            lights: vec![LightId(4), LightId(7)],
+            flip_normals: false,
+            alpha: None,
+        };
+        for flip in [false, true] {
+            m.flip_normals = flip;
+            for tri in 0..2 {
+                for bary in [Vec2::new(0.2, 0.3), Vec2::new(0.7, 0.1), Vec2::ZERO] {
+                    let fast = bare_triangle_interaction(&m, tri, 1.5, bary);
+                    let full = full_triangle_interaction(&m, None, tri, 1.5, bary);
+                    assert_eq!(format!("{fast:?}"), format!("{full:?}"));
+                }
+            }
+        }
+        m.lights.clear();
+        let si = triangle_interaction(&m, None, 1, 1.0, Vec2::splat(0.25));
+        assert!(si.light.is_none());
     }
 }

@@ -22,6 +22,7 @@ pub enum Texture {
 }
 
 impl Texture {
+    #[inline]
     pub fn eval(&self, uv: Vec2) -> Vec3 {
         match self {
             Texture::Constant(c) => *c,

@@ -15,6 +15,7 @@ pub struct Diffuse {
 }
 
 impl Diffuse {
+    #[inline]
     pub fn f(&self, wo: Vec3, wi: Vec3) -> Vec3 {
         if wo.z * wi.z <= 0.0 {
             return Vec3::ZERO;
@@ -22,6 +23,7 @@ impl Diffuse {
         self.albedo * FRAC_1_PI
     }
 
+    #[inline]
     pub fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
         if wo.z * wi.z <= 0.0 {
             return 0.0;
@@ -29,9 +31,27 @@ impl Diffuse {
         cosine_hemisphere_pdf(wi.z.abs())
     }
 
+    /// [`Self::f`] times |cos θᵢ|, and [`Self::pdf`], from the local z of `wo` and `wi`
+    /// (all the lobe reads of them).
+    #[inline]
+    pub fn f_cos_pdf(&self, cos_o: f32, cos_i: f32) -> (Vec3, f32) {
+        if cos_o * cos_i <= 0.0 {
+            return (Vec3::ZERO, 0.0);
+        }
+        let cos = cos_i.abs();
+        (self.albedo * FRAC_1_PI * cos, cosine_hemisphere_pdf(cos))
+    }
+
+    #[inline]
     pub fn sample(&self, wo: Vec3, _u_lobe: f32, u: Vec2) -> Option<BsdfSample> {
+        self.sample_from(wo.z, u)
+    }
+
+    /// [`Self::sample`] from the local z of `wo`, all it reads of it.
+    #[inline]
+    pub fn sample_from(&self, cos_o: f32, u: Vec2) -> Option<BsdfSample> {
         let mut wi = sample_cosine_hemisphere(u);
-        if wo.z < 0.0 {
+        if cos_o < 0.0 {
             wi.z = -wi.z;
         }
         let pdf = cosine_hemisphere_pdf(wi.z.abs());

@@ -92,12 +92,14 @@ pub enum Lobe {
 }
 
 /// Mirrors a direction through the surface plane (z → −z).
+#[inline]
 fn flip_z(w: Vec3) -> Vec3 {
     Vec3::new(w.x, w.y, -w.z)
 }
 
 impl Lobe {
     /// Reflection-only lobes, evaluated in the hemisphere of `wo` (two-sided).
+    #[inline]
     fn reflective_f(&self, wo: Vec3, wi: Vec3) -> Vec3 {
         match self {
             Lobe::Diffuse(l) => l.f(wo, wi),
@@ -108,6 +110,7 @@ impl Lobe {
         }
     }
 
+    #[inline]
     pub fn f(&self, wo: Vec3, wi: Vec3) -> Vec3 {
         match self {
             Lobe::Dielectric(l) => l.f(wo, wi),
@@ -117,6 +120,7 @@ impl Lobe {
         }
     }
 
+    #[inline]
     pub fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
         let (wo, wi) = if wo.z < 0.0 && self.is_reflective() {
             (flip_z(wo), flip_z(wi))
@@ -133,6 +137,7 @@ impl Lobe {
         }
     }
 
+    #[inline]
     pub fn sample(&self, wo: Vec3, u_lobe: f32, u: Vec2) -> Option<BsdfSample> {
         let flip = wo.z < 0.0 && self.is_reflective();
         let wo = if flip { flip_z(wo) } else { wo };
@@ -156,10 +161,12 @@ impl Lobe {
 
     /// Whether [`Self::sample`] reads `u_lobe` (the lambertian and conductor lobes have
     /// one component and ignore it).
+    #[inline]
     pub fn takes_lobe_sample(&self) -> bool {
         !matches!(self, Lobe::Diffuse(_) | Lobe::Conductor(_))
     }
 
+    #[inline]
     fn is_reflective(&self) -> bool {
         !matches!(self, Lobe::Dielectric(_) | Lobe::ThinDielectric(_))
     }
@@ -167,6 +174,7 @@ impl Lobe {
     /// Whether every component is a delta (then NEE is pointless). Plastic is not: its
     /// coat is a delta but its base is diffuse, and NEE goes through `f`/`pdf`, which
     /// hold only the diffuse part.
+    #[inline]
     pub fn is_delta(&self) -> bool {
         match self {
             Lobe::Diffuse(_) | Lobe::Plastic(_) | Lobe::MetalRough(_) => false,
@@ -190,6 +198,7 @@ pub struct Bsdf {
 }
 
 impl Bsdf {
+    #[inline]
     pub fn new(ns: Vec3, ng: Vec3, lobe: Lobe) -> Bsdf {
         Bsdf {
             frame: Frame::from_z(ns),
@@ -221,20 +230,24 @@ impl Bsdf {
 
     /// Whether the geometric normal agrees with the shading frame on reflection versus
     /// transmission for this pair (see the module's conventions on light leaks).
-    fn sides_agree(&self, wo: Vec3, wi: Vec3, lo: Vec3, li: Vec3) -> bool {
+    #[inline(always)]
+    /// `cos_o` and `cos_i` are the local z of `wo` and `wi` (their shading cosines).
+    fn sides_agree(&self, wo: Vec3, wi: Vec3, cos_o: f32, cos_i: f32) -> bool {
         let geometric_reflection = wo.dot(self.ng) * wi.dot(self.ng) > 0.0;
-        let shading_reflection = lo.z * li.z > 0.0;
+        let shading_reflection = cos_o * cos_i > 0.0;
         geometric_reflection == shading_reflection
     }
 
-    /// Whether `wo` (local) sees nothing: grazing, or the back of a one-sided BSDF.
-    fn blind(&self, lo: Vec3) -> bool {
-        lo.z == 0.0 || (self.one_sided && lo.z < 0.0)
+    /// Whether `wo`, of shading cosine `cos_o`, sees nothing: grazing, or the back of a
+    /// one-sided BSDF.
+    #[inline(always)]
+    fn blind(&self, cos_o: f32) -> bool {
+        cos_o == 0.0 || (self.one_sided && cos_o < 0.0)
     }
 
     pub fn f(&self, wo: Vec3, wi: Vec3) -> Vec3 {
         let (lo, li) = (self.frame.to_local(wo), self.frame.to_local(wi));
-        if self.blind(lo) || !self.sides_agree(wo, wi, lo, li) {
+        if self.blind(lo.z) || !self.sides_agree(wo, wi, lo.z, li.z) {
             return Vec3::ZERO;
         }
         self.lobe.f(lo, li)
@@ -242,7 +255,7 @@ impl Bsdf {
 
     pub fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
         let (lo, li) = (self.frame.to_local(wo), self.frame.to_local(wi));
-        if self.blind(lo) || !self.sides_agree(wo, wi, lo, li) {
+        if self.blind(lo.z) || !self.sides_agree(wo, wi, lo.z, li.z) {
             return 0.0;
         }
         self.lobe.pdf(lo, li)
@@ -250,35 +263,68 @@ impl Bsdf {
 
     /// [`Self::f`] times |cos θᵢ|, and [`Self::pdf`], of one pair of directions: what next
     /// event estimation asks for, with one change of frame instead of three.
+    #[inline]
     pub fn f_cos_pdf(&self, wo: Vec3, wi: Vec3) -> (Vec3, f32) {
+        if let Lobe::Diffuse(d) = &self.lobe {
+            // The Lambertian lobe reads only the two cosines: two dot products instead of
+            // two changes of frame, and one dispatch instead of two.
+            let (cos_o, cos_i) = (wo.dot(self.frame.n), wi.dot(self.frame.n));
+            if self.blind(cos_o) || !self.sides_agree(wo, wi, cos_o, cos_i) {
+                return (Vec3::ZERO, 0.0);
+            }
+            return d.f_cos_pdf(cos_o, cos_i);
+        }
         let (lo, li) = (self.frame.to_local(wo), self.frame.to_local(wi));
-        if self.blind(lo) || !self.sides_agree(wo, wi, lo, li) {
+        if self.blind(lo.z) || !self.sides_agree(wo, wi, lo.z, li.z) {
             return (Vec3::ZERO, 0.0);
         }
         (self.lobe.f(lo, li) * li.z.abs(), self.lobe.pdf(lo, li))
     }
 
+    #[inline]
     pub fn sample(&self, wo: Vec3, u_lobe: f32, u: Vec2) -> Option<BsdfSample> {
-        let lo = self.frame.to_local(wo);
-        if self.blind(lo) {
-            return None;
-        }
-        let s = self.lobe.sample(lo, u_lobe, u)?;
-        if s.pdf == 0.0 || !s.pdf.is_finite() || s.wi.z == 0.0 || !s.f.is_finite() {
-            return None;
-        }
+        let (cos_o, s) = match &self.lobe {
+            // The Lambertian lobe reads only the cosine of `wo` (one dot product, not a
+            // change of frame) and is two-sided already (no mirroring of `wo` and back).
+            Lobe::Diffuse(d) => {
+                let cos_o = wo.dot(self.frame.n);
+                if self.blind(cos_o) {
+                    return None;
+                }
+                let s = d.sample_from(cos_o, u)?;
+                // Its pdf, |cos θᵢ|/π, is positive (or no sample) and finite, so wi.z ≠ 0:
+                // only f is left to check.
+                if !s.f.is_finite() {
+                    return None;
+                }
+                (cos_o, s)
+            }
+            lobe => {
+                let lo = self.frame.to_local(wo);
+                if self.blind(lo.z) {
+                    return None;
+                }
+                let s = lobe.sample(lo, u_lobe, u)?;
+                if s.pdf == 0.0 || !s.pdf.is_finite() || s.wi.z == 0.0 || !s.f.is_finite() {
+                    return None;
+                }
+                (lo.z, s)
+            }
+        };
         let wi = self.frame.to_world(s.wi);
-        if !self.sides_agree(wo, wi, lo, s.wi) {
+        if !self.sides_agree(wo, wi, cos_o, s.wi.z) {
             return None;
         }
         Some(BsdfSample { wi, ..s })
     }
 
+    #[inline]
     pub fn is_delta(&self) -> bool {
         self.lobe.is_delta()
     }
 
     /// |cos θ| of `wi` against the shading normal.
+    #[inline]
     pub fn abs_cos(&self, wi: Vec3) -> f32 {
         wi.dot(self.frame.n).abs()
     }

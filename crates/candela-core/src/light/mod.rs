@@ -98,6 +98,7 @@ impl LightSample {
     /// normal `n` and `area`, seen from `from`: the area density turned into solid angle,
     /// d²/(cos θ_l · A). `radiance(wi)` gives the radiance leaving towards −`wi`. `None`
     /// where `p` is the shading point itself or faces away.
+    #[inline]
     pub fn uniform_area(
         from: Vec3,
         p: Vec3,
@@ -142,6 +143,7 @@ pub enum Light {
 }
 
 impl Light {
+    #[inline]
     pub fn sample_li(&self, ctx: &ShadingCtx, u: Vec2) -> Option<LightSample> {
         let s = match self {
             Light::Point(l) => l.sample_li(ctx),
@@ -158,6 +160,7 @@ impl Light {
     }
 
     /// Density in solid angle with which [`Self::sample_li`] picks direction `wi` at `ctx`.
+    #[inline]
     pub fn pdf_li(&self, ctx: &ShadingCtx, wi: Vec3) -> f32 {
         match self {
             Light::Point(_)
@@ -173,6 +176,7 @@ impl Light {
     }
 
     /// Radiance leaving an area light at a point with geometric normal `n` in direction `w`.
+    #[inline]
     pub fn radiance(&self, n: Vec3, w: Vec3) -> Vec3 {
         match self {
             Light::Point(_)
@@ -254,6 +258,7 @@ impl Light {
         }
     }
 
+    #[inline]
     pub fn is_delta(&self) -> bool {
         matches!(
             self,

@@ -86,11 +86,13 @@ impl ParallelogramLight {
         ParallelogramLight::new(x, s0 - x, s1 - x, a.n, a.le)
     }
 
+    #[inline]
     pub fn sample_li(&self, ctx: &ShadingCtx, u: Vec2) -> Option<LightSample> {
         let p = self.p0 + self.e1 * u.x + self.e2 * u.y;
         LightSample::uniform_area(ctx.p, p, self.n, self.area, |_| self.le)
     }
 
+    #[inline]
     pub fn pdf_li(&self, ctx: &ShadingCtx, wi: Vec3) -> f32 {
         let cos_l = -wi.dot(self.n);
         if cos_l <= 0.0 {
@@ -109,6 +111,7 @@ impl ParallelogramLight {
         t * t / (cos_l * self.area)
     }
 
+    #[inline]
     pub fn radiance(&self, n: Vec3, w: Vec3) -> Vec3 {
         if n.dot(w) > 0.0 {
             self.le

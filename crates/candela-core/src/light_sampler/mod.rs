@@ -64,6 +64,11 @@ impl LightSampler {
             count: lights.len() as u32,
         };
         let powers = || -> Vec<f32> { lights.iter().map(Light::power).collect() };
+        // One light: the alias table and the array pick it with probability exactly 1, as
+        // the uniform sampler does in fewer instructions (5% of the Cornell box's NEE).
+        if lights.len() == 1 && matches!(kind, LightSamplerKind::Power | LightSamplerKind::Array) {
+            return uniform;
+        }
         // Where no power can be estimated (zero everywhere), every sampler falls back to
         // uniform picks so that nothing that might emit is ignored.
         match kind {
@@ -86,6 +91,7 @@ impl LightSampler {
 
     /// Picks a light at `ctx` from one uniform number `u`; `None` where no light can
     /// contribute. `lights` must be the slice the sampler was built from.
+    #[inline]
     pub fn sample(&self, ctx: &ShadingCtx, u: f32, lights: &[Light]) -> Option<LightPick> {
         let pick = |id: u32, pmf: f32| LightPick {
             id: LightId(id),
@@ -113,6 +119,7 @@ impl LightSampler {
 
     /// Probability that [`Self::sample`] picks `light` at `ctx`, as MIS uses it: exact
     /// for every sampler but RIS, whose surrogate is explained in [`ris`].
+    #[inline]
     pub fn pmf(&self, ctx: &ShadingCtx, light: LightId) -> f32 {
         match self {
             LightSampler::Empty => 0.0,
@@ -121,6 +128,40 @@ impl LightSampler {
             LightSampler::Array(a) => a.pmf(light.0),
             LightSampler::Bvh(b) => b.pmf(ctx, light.0),
             LightSampler::Ris(r) => r.mis_pmf(ctx, light),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use glam::Vec3;
+
+    use super::*;
+    use crate::light::ParallelogramLight;
+
+    #[test]
+    fn one_light_is_picked_with_probability_one_by_every_power_sampler() {
+        let lamp = ParallelogramLight::new(Vec3::ZERO, Vec3::X, Vec3::Z, -Vec3::Y, Vec3::ONE)
+            .map(Light::Parallelogram)
+            .unwrap();
+        let lights = [lamp];
+        let ctx = ShadingCtx {
+            p: Vec3::new(0.5, -1.0, 0.5),
+            n: Vec3::Y,
+        };
+        // What the alias table and the array would give: the whole probability.
+        let table = AliasTable::new(&[lights[0].power()]).unwrap();
+        let array = LightArray::new(&[lights[0].power()]).unwrap();
+        for kind in [LightSamplerKind::Power, LightSamplerKind::Array] {
+            let s = LightSampler::new(kind, 1, &lights);
+            for u in [0.0, 0.3, 0.999_999] {
+                let pick = s.sample(&ctx, u, &lights).unwrap();
+                assert_eq!(pick.id, LightId(0));
+                assert_eq!(pick.pmf, table.sample(u).1);
+                assert_eq!(pick.pmf, array.sample(u).1);
+                assert_eq!(pick.mis_pmf, 1.0);
+            }
+            assert_eq!(s.pmf(&ctx, LightId(0)), 1.0);
         }
     }
 }

@@ -189,9 +189,11 @@ impl Sampler for SobolSampler {
     #[inline]
     fn get_2d(&mut self) -> Vec2 {
         let (i, h) = self.next_request(2);
-        let x = scramble_reversed(i, (h >> 32) as u32).reverse_bits();
-        let y = scramble_reversed(sobol_dim1_reversed(i), y_seed(h)).reverse_bits();
-        Vec2::new(to_unit(x), to_unit(y))
+        let x = scramble_reversed(i, (h >> 32) as u32);
+        let y = scramble_reversed(sobol_dim1_reversed(i), y_seed(h));
+        // Both coordinates reversed by one 64-bit reversal: (x, y) → (rev y, rev x).
+        let xy = ((x as u64) << 32 | y as u64).reverse_bits();
+        Vec2::new(to_unit(xy as u32), to_unit((xy >> 32) as u32))
     }
 }
 
