@@ -84,7 +84,14 @@ fn encode_exr(image: &LinearImage) -> Result<Vec<u8>, String> {
         let p = image.pixels[pos.y() * w + pos.x()];
         (p.x, p.y, p.z)
     });
-    let exr_image = Image::from_channels((w, image.height as usize), channels);
+    // The default's tiles and RLE, but written in increasing order: with the default
+    // "unspecified" order the tiles land in the order the compressing threads finish, so
+    // two runs of the same render gave files with equal pixels and different bytes.
+    let encoding = Encoding {
+        line_order: LineOrder::Increasing,
+        ..Encoding::FAST_LOSSLESS
+    };
+    let exr_image = Image::from_encoded_channels((w, image.height as usize), encoding, channels);
     let mut out = Cursor::new(Vec::new());
     exr_image
         .write()
@@ -132,6 +139,32 @@ mod tests {
         assert_eq!(&bytes[..header.len()], header);
         let first = f32::from_le_bytes(bytes[header.len()..header.len() + 4].try_into().unwrap());
         assert_eq!(first, 4.0, "the bottom row comes first");
+    }
+
+    #[test]
+    fn exr_bytes_depend_only_on_the_pixels() {
+        // 64 tiles of 64², compressed in parallel: the file must still be the same bytes
+        // every time, and say its tiles are in increasing order.
+        let px: Vec<Vec3> = (0..512 * 512)
+            .map(|i| Vec3::new((i % 7) as f32, (i % 13) as f32 * 0.5, (i / 512) as f32))
+            .collect();
+        let image = LinearImage {
+            width: 512,
+            height: 512,
+            pixels: &px,
+        };
+        let first = encode_exr(&image).unwrap();
+        let meta = exr::meta::MetaData::read_from_buffered(Cursor::new(&first), false).unwrap();
+        assert_eq!(
+            meta.headers[0].line_order,
+            exr::meta::attribute::LineOrder::Increasing
+        );
+        for _ in 0..10 {
+            assert!(
+                encode_exr(&image).unwrap() == first,
+                "the bytes changed between runs"
+            );
+        }
     }
 
     #[test]
