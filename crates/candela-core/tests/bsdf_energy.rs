@@ -238,34 +238,30 @@ fn lossless_layers_return_one() {
 
 #[test]
 fn reflection_is_reciprocal() {
+    let copper = |distrib| {
+        Lobe::Conductor(Conductor {
+            distrib,
+            fresnel: ConductorFresnel::Complex {
+                eta: Vec3::new(0.2, 0.9, 1.1),
+                k: Vec3::new(3.9, 2.4, 2.1),
+            },
+        })
+    };
+    let glass = |distrib| {
+        Lobe::Dielectric(Dielectric {
+            tint: Vec3::ONE,
+            eta: 1.5,
+            distrib,
+        })
+    };
     let lobes = [
         Lobe::Diffuse(Diffuse {
             albedo: Vec3::splat(0.5),
         }),
-        Lobe::Conductor(Conductor {
-            distrib: Microfacet::ggx(0.3, 0.1),
-            fresnel: ConductorFresnel::Complex {
-                eta: Vec3::new(0.2, 0.9, 1.1),
-                k: Vec3::new(3.9, 2.4, 2.1),
-            },
-        }),
-        Lobe::Dielectric(Dielectric {
-            tint: Vec3::ONE,
-            eta: 1.5,
-            distrib: Microfacet::ggx(0.4, 0.4),
-        }),
-        Lobe::Conductor(Conductor {
-            distrib: Microfacet::beckmann(0.3, 0.1),
-            fresnel: ConductorFresnel::Complex {
-                eta: Vec3::new(0.2, 0.9, 1.1),
-                k: Vec3::new(3.9, 2.4, 2.1),
-            },
-        }),
-        Lobe::Dielectric(Dielectric {
-            tint: Vec3::ONE,
-            eta: 1.5,
-            distrib: Microfacet::beckmann(0.4, 0.2),
-        }),
+        copper(Microfacet::ggx(0.3, 0.1)),
+        glass(Microfacet::ggx(0.4, 0.4)),
+        copper(Microfacet::beckmann(0.3, 0.1)),
+        glass(Microfacet::beckmann(0.4, 0.2)),
         Lobe::Plastic(Plastic::new(Vec3::new(0.3, 0.6, 0.9), 1.5)),
         Lobe::MetalRough(MetalRough::new(Vec3::new(0.9, 0.5, 0.2), 0.3, 0.5)),
     ];
