@@ -4,6 +4,7 @@
 
 use std::sync::atomic::AtomicBool;
 
+use candela_core::bsdf::{Conductor, Dielectric, Lobe, Microfacet};
 use candela_core::build::{build, build_texture};
 use candela_core::desc::*;
 use candela_core::geometry::Ray;
@@ -131,6 +132,26 @@ fn conductors_take_presets_or_eta_and_k_and_are_one_sided() {
         let loaded = load(&format!(r#"<shape type="cube">{body}</shape>"#));
         assert_eq!(distribution(&loaded.desc.materials[0].bsdf), want, "{body}");
         assert!(loaded.warnings.is_empty(), "{body}: {:?}", loaded.warnings);
+        // And the build renders it with that distribution.
+        let scene = build(&loaded.desc).unwrap();
+        let lobe = match &scene.materials[0] {
+            candela_core::material::Material::OneSided(inner) => match **inner {
+                candela_core::material::Material::Fixed(lobe) => lobe,
+                ref other => panic!("{other:?}"),
+            },
+            candela_core::material::Material::Fixed(lobe) => *lobe,
+            other => panic!("{other:?}"),
+        };
+        let built = match lobe {
+            Lobe::Conductor(Conductor { distrib, .. })
+            | Lobe::Dielectric(Dielectric { distrib, .. }) => distrib,
+            other => panic!("{other:?}"),
+        };
+        assert_eq!(
+            matches!(built, Microfacet::Beckmann(_)),
+            want == MicrofacetDesc::Beckmann,
+            "{body}: {built:?}"
+        );
     }
     // An unknown distribution is an error at the property's position.
     let e = load_err(

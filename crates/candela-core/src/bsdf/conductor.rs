@@ -1,5 +1,5 @@
-//! Metals: smooth (a perfect mirror) or rough (GGX or Beckmann microfacets), with the complex Fresnel
-//! reflectance of a conductor per RGB channel.
+//! Metals: smooth (a perfect mirror) or rough (GGX or Beckmann microfacets), with the
+//! complex Fresnel reflectance of a conductor per RGB channel.
 
 use glam::{Vec2, Vec3};
 
@@ -28,8 +28,9 @@ impl ConductorFresnel {
 
 /// A conductor: a delta mirror when the distribution is [effectively
 /// smooth](MicrofacetDistribution::effectively_smooth), otherwise the Torrance–Sparrow
-/// BRDF D·G·F/(4 cos θo cos θi) sampled by visible normals (pbrt-v4 §9.6.4). Reflection only;
-/// `wo` must lie in the upper hemisphere (the [`super::Lobe`] mirrors the back side).
+/// BRDF D·G·F/(4 cos θo cos θi) sampled by visible normals (pbrt-v4 §9.6.4). Reflection
+/// only; `wo` must lie in the upper hemisphere (the [`super::Lobe`] mirrors the back
+/// side).
 #[derive(Clone, Copy, Debug)]
 pub struct Conductor {
     pub distrib: Microfacet,
