@@ -11,13 +11,14 @@ use glam::{Mat3, Mat4, Vec2, Vec3};
 use crate::accel::{Accel, Shape};
 use crate::alpha::{AlphaMask, AlphaMode};
 use crate::bsdf::{
-    Conductor, ConductorFresnel, Dielectric, Lobe, Plastic, ThinDielectric, TrowbridgeReitz,
+    Conductor, ConductorFresnel, Dielectric, Lobe, Microfacet, MicrofacetDistribution, Plastic,
+    ThinDielectric,
 };
 use crate::camera::Camera;
 use crate::desc::{
     ApertureDesc, ApertureSizeDesc, BsdfDesc, CameraDesc, EnvironmentDesc, EnvironmentMapDesc,
-    FocusDesc, GeometryDesc, ImageDesc, LensDesc, MeshDesc, PixelFilterDesc, SceneDesc, ShapeDesc,
-    Span, TextureDesc,
+    FocusDesc, GeometryDesc, ImageDesc, LensDesc, MeshDesc, MicrofacetDesc, PixelFilterDesc,
+    SceneDesc, ShapeDesc, Span, TextureDesc,
 };
 use crate::filter::PixelFilter;
 use crate::geometry::Aabb;
@@ -532,13 +533,22 @@ pub fn build_texture(t: &TextureDesc, span: &Span, what: &str) -> Result<Texture
     }
 }
 
-fn check_alpha(span: &Span, alpha_u: f32, alpha_v: f32) -> Result<TrowbridgeReitz, BuildError> {
+fn microfacet(
+    span: &Span,
+    alpha_u: f32,
+    alpha_v: f32,
+    distribution: MicrofacetDesc,
+) -> Result<Microfacet, BuildError> {
     check_finite(span, "roughness", &[alpha_u, alpha_v])?;
     if alpha_u < 0.0 || alpha_v < 0.0 {
         return err(span, "roughness must not be negative");
     }
     // Tiny but non-zero α would overflow D; below the smooth threshold it is a mirror.
-    Ok(TrowbridgeReitz::new(alpha_u.max(1e-4), alpha_v.max(1e-4)))
+    let (u, v) = (alpha_u.max(1e-4), alpha_v.max(1e-4));
+    Ok(match distribution {
+        MicrofacetDesc::Ggx => Microfacet::ggx(u, v),
+        MicrofacetDesc::Beckmann => Microfacet::beckmann(u, v),
+    })
 }
 
 fn check_eta(span: &Span, eta: f32) -> Result<(), BuildError> {
@@ -558,11 +568,12 @@ fn build_material(bsdf: &BsdfDesc, span: &Span) -> Result<Material, BuildError> 
             k,
             alpha_u,
             alpha_v,
+            distribution,
         } => {
             check_color(span, "eta", *eta)?;
             check_color(span, "k", *k)?;
             Material::Fixed(Lobe::Conductor(Conductor {
-                distrib: check_alpha(span, *alpha_u, *alpha_v)?,
+                distrib: microfacet(span, *alpha_u, *alpha_v, *distribution)?,
                 fresnel: ConductorFresnel::Complex { eta: *eta, k: *k },
             }))
         }
@@ -570,11 +581,12 @@ fn build_material(bsdf: &BsdfDesc, span: &Span) -> Result<Material, BuildError> 
             eta,
             alpha_u,
             alpha_v,
+            distribution,
             thin,
             tint,
         } => {
             check_eta(span, *eta)?;
-            let distrib = check_alpha(span, *alpha_u, *alpha_v)?;
+            let distrib = microfacet(span, *alpha_u, *alpha_v, *distribution)?;
             let clear = matches!(tint, TextureDesc::Constant(c) if *c == Vec3::ONE);
             if *thin {
                 if !distrib.effectively_smooth() {

@@ -153,9 +153,9 @@ pub struct MaterialDesc {
     pub span: Span,
 }
 
-/// The scattering model of a material. Roughnesses are GGX α (α = perceptual
-/// roughness²); α below 10⁻³ makes a smooth (delta) interface. `eta` is the relative
-/// index of refraction, inside over outside.
+/// The scattering model of a material. Roughnesses are the α of the microfacet
+/// `distribution` (for GGX, α = perceptual roughness²); α below 10⁻³ makes a smooth
+/// (delta) interface. `eta` is the relative index of refraction, inside over outside.
 #[derive(Clone, Debug)]
 pub enum BsdfDesc {
     /// Lambertian reflection with the given albedo.
@@ -167,12 +167,14 @@ pub enum BsdfDesc {
         k: Vec3,
         alpha_u: f32,
         alpha_v: f32,
+        distribution: MicrofacetDesc,
     },
     /// Glass-like interface; `thin` makes a thin sheet (no net refraction, smooth only).
     Dielectric {
         eta: f32,
         alpha_u: f32,
         alpha_v: f32,
+        distribution: MicrofacetDesc,
         thin: bool,
         /// Multiplies transmission only (glTF's base colour under KHR_materials_transmission);
         /// constant one for clear glass. Not for thin sheets.
@@ -206,6 +208,18 @@ pub enum BsdfDesc {
         alpha: AlphaDesc,
         inner: Box<BsdfDesc>,
     },
+}
+
+/// The microfacet distribution of a rough conductor or dielectric (ignored when smooth).
+/// α means what it does in Walter et al. 2007, pbrt and Mitsuba; at equal α, Beckmann's
+/// highlight has the shorter tails.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum MicrofacetDesc {
+    /// Trowbridge–Reitz: Candela's TOML and glTF default.
+    #[default]
+    Ggx,
+    /// Beckmann: Mitsuba's default.
+    Beckmann,
 }
 
 /// A surface's coverage α = `factor` × the texture's first channel (1 without one).

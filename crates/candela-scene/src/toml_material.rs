@@ -6,7 +6,7 @@ use std::path::Path;
 use std::sync::Arc;
 
 use candela_core::bsdf::metal_preset;
-use candela_core::desc::{BsdfDesc, ImageTextureDesc, TextureDesc, WrapMode};
+use candela_core::desc::{BsdfDesc, ImageTextureDesc, MicrofacetDesc, TextureDesc, WrapMode};
 use glam::{Affine2, Vec3};
 use serde::de::{self, IgnoredAny, MapAccess, Visitor};
 use serde::{Deserialize, Deserializer};
@@ -64,6 +64,14 @@ enum Wrap {
     Repeat,
     Clamp,
     Mirror,
+}
+
+/// `distribution = "ggx" | "beckmann"` of a rough conductor or dielectric.
+#[derive(Debug, Deserialize, Clone, Copy)]
+#[serde(rename_all = "snake_case")]
+enum Distribution {
+    Ggx,
+    Beckmann,
 }
 
 #[derive(Debug, Deserialize, Clone, Copy)]
@@ -126,6 +134,7 @@ struct MaterialEntry {
     alpha: Option<Num>,
     alpha_u: Option<Num>,
     alpha_v: Option<Num>,
+    distribution: Option<Distribution>,
     thin: Option<bool>,
     two_sided: Option<bool>,
 }
@@ -144,8 +153,16 @@ const DEFAULT_ALBEDO: f32 = 0.5;
 fn allowed_keys(kind: &str) -> &'static [&'static str] {
     match kind {
         "diffuse" => &["albedo"],
-        "conductor" => &["preset", "eta", "k", "alpha", "alpha_u", "alpha_v"],
-        "dielectric" => &["eta", "alpha", "alpha_u", "alpha_v", "thin"],
+        "conductor" => &[
+            "preset",
+            "eta",
+            "k",
+            "alpha",
+            "alpha_u",
+            "alpha_v",
+            "distribution",
+        ],
+        "dielectric" => &["eta", "alpha", "alpha_u", "alpha_v", "distribution", "thin"],
         "plastic" => &["albedo", "eta"],
         "metal_rough" => &["base_color", "metallic", "roughness"],
         _ => &[],
@@ -182,6 +199,10 @@ pub(crate) fn parse_material(
         let a = m.alpha.map_or(0.0, |n| n.0);
         (m.alpha_u.map_or(a, |n| n.0), m.alpha_v.map_or(a, |n| n.0))
     };
+    let distribution = match m.distribution {
+        None | Some(Distribution::Ggx) => MicrofacetDesc::Ggx,
+        Some(Distribution::Beckmann) => MicrofacetDesc::Beckmann,
+    };
     let bsdf = match kind {
         "diffuse" => BsdfDesc::Diffuse {
             albedo: tex(m.albedo, Vec3::splat(DEFAULT_ALBEDO), Slot::Color)?,
@@ -213,6 +234,7 @@ pub(crate) fn parse_material(
                 k,
                 alpha_u,
                 alpha_v,
+                distribution,
             }
         }
         "dielectric" => {
@@ -221,6 +243,7 @@ pub(crate) fn parse_material(
                 eta: scalar_eta(src, m.eta)?,
                 alpha_u,
                 alpha_v,
+                distribution,
                 thin: m.thin.unwrap_or(false),
                 tint: TextureDesc::Constant(Vec3::ONE),
             }

@@ -259,6 +259,7 @@ fn every_feature_round_trips_into_the_expected_description() {
         alpha_v,
         thin,
         tint: TextureDesc::Constant(tint),
+        ..
     } = **inner
     else {
         panic!()

@@ -4,6 +4,7 @@
 
 use std::sync::atomic::AtomicBool;
 
+use candela_core::bsdf::{Conductor, Dielectric, Lobe, Microfacet};
 use candela_core::build::{build, build_texture};
 use candela_core::desc::*;
 use candela_core::geometry::Ray;
@@ -57,6 +58,7 @@ fn conductors_take_presets_or_eta_and_k_and_are_one_sided() {
                 k,
                 alpha_u,
                 alpha_v,
+                ..
             } => {
                 assert_eq!((eta, k, alpha_u, alpha_v), (au_eta, au_k, 0.0, 0.0));
             }
@@ -79,10 +81,12 @@ fn conductors_take_presets_or_eta_and_k_and_are_one_sided() {
             k,
             alpha_u,
             alpha_v,
+            distribution,
         } => {
             assert_eq!(eta, Vec3::new(0.2, 0.9, 1.1));
             assert_eq!(k, Vec3::new(3.9, 2.4, 1.6));
             assert_eq!((alpha_u, alpha_v), (0.05, 0.3));
+            assert_eq!(distribution, MicrofacetDesc::Ggx);
         }
         other => panic!("{other:?}"),
     }
@@ -93,28 +97,71 @@ fn conductors_take_presets_or_eta_and_k_and_are_one_sided() {
         } => assert_eq!((alpha_u, alpha_v), (0.1, 0.1)),
         other => panic!("{other:?}"),
     }
-    // Beckmann is rendered as GGX, with a warning saying so.
-    let loaded = load(
-        r#"<shape type="cube"><bsdf type="roughconductor">
-           <string name="distribution" value="beckmann"/></bsdf></shape>"#,
-    );
-    assert!(
-        loaded.warnings.iter().any(|w| w.contains("beckmann")),
-        "{:?}",
-        loaded.warnings
-    );
-    // So is Mitsuba's default, which is beckmann; an explicit ggx is exact and silent.
-    for (body, warns) in [
-        (r#"<bsdf type="roughdielectric"/>"#, true),
+    // The distribution maps exactly and silently: Mitsuba's default is beckmann, an
+    // explicit beckmann or ggx is what it says, for conductors and dielectrics alike.
+    let distribution = |d: &BsdfDesc| match d {
+        BsdfDesc::Conductor { distribution, .. } | BsdfDesc::Dielectric { distribution, .. } => {
+            *distribution
+        }
+        BsdfDesc::OneSided(inner) => match **inner {
+            BsdfDesc::Conductor { distribution, .. } => distribution,
+            ref other => panic!("{other:?}"),
+        },
+        other => panic!("{other:?}"),
+    };
+    for (body, want) in [
+        (r#"<bsdf type="roughconductor"/>"#, MicrofacetDesc::Beckmann),
+        (
+            r#"<bsdf type="roughconductor"><string name="distribution" value="beckmann"/></bsdf>"#,
+            MicrofacetDesc::Beckmann,
+        ),
         (
             r#"<bsdf type="roughconductor"><string name="distribution" value="ggx"/></bsdf>"#,
-            false,
+            MicrofacetDesc::Ggx,
+        ),
+        (
+            r#"<bsdf type="roughdielectric"/>"#,
+            MicrofacetDesc::Beckmann,
+        ),
+        (
+            r#"<bsdf type="roughdielectric"><string name="distribution" value="ggx"/>
+               <float name="alpha_u" value="0.1"/><float name="alpha_v" value="0.2"/></bsdf>"#,
+            MicrofacetDesc::Ggx,
         ),
     ] {
         let loaded = load(&format!(r#"<shape type="cube">{body}</shape>"#));
-        let warned = loaded.warnings.iter().any(|w| w.contains("beckmann"));
-        assert_eq!(warned, warns, "{body}: {:?}", loaded.warnings);
+        assert_eq!(distribution(&loaded.desc.materials[0].bsdf), want, "{body}");
+        assert!(loaded.warnings.is_empty(), "{body}: {:?}", loaded.warnings);
+        // And the build renders it with that distribution.
+        let scene = build(&loaded.desc).unwrap();
+        let lobe = match &scene.materials[0] {
+            candela_core::material::Material::OneSided(inner) => match **inner {
+                candela_core::material::Material::Fixed(lobe) => lobe,
+                ref other => panic!("{other:?}"),
+            },
+            candela_core::material::Material::Fixed(lobe) => *lobe,
+            other => panic!("{other:?}"),
+        };
+        let built = match lobe {
+            Lobe::Conductor(Conductor { distrib, .. })
+            | Lobe::Dielectric(Dielectric { distrib, .. }) => distrib,
+            other => panic!("{other:?}"),
+        };
+        assert_eq!(
+            matches!(built, Microfacet::Beckmann(_)),
+            want == MicrofacetDesc::Beckmann,
+            "{body}: {built:?}"
+        );
     }
+    // An unknown distribution is an error at the property's position.
+    let e = load_err(
+        r#"<shape type="cube"><bsdf type="roughdielectric">
+           <string name="distribution" value="phong"/></bsdf></shape>"#,
+    );
+    assert!(
+        e.contains("scene.xml:3:") && e.contains("unknown microfacet distribution \"phong\""),
+        "{e}"
+    );
     for (body, what) in [
         (
             r#"<bsdf type="conductor"><string name="material" value="W"/></bsdf>"#,

@@ -2,7 +2,7 @@
 
 use std::path::Path;
 
-use candela_core::desc::{BsdfDesc, TextureDesc, WrapMode};
+use candela_core::desc::{BsdfDesc, MicrofacetDesc, TextureDesc, WrapMode};
 use candela_scene::parse_toml_scene;
 use glam::{Vec2, Vec3};
 
@@ -24,6 +24,7 @@ fn every_material_type_parses() {
         k,
         alpha_u,
         alpha_v,
+        ..
     } = material("type = \"conductor\"\npreset = \"Au\"\nalpha_u = 0.1\nalpha_v = 0.3").unwrap()
     else {
         panic!()
@@ -132,10 +133,44 @@ fn errors_point_at_the_key() {
         ("type = \"diffuse\"\nalbedo = { type = \"checker\", file = \"a.png\" }", "does not belong"),
         ("type = \"diffuse\"\nalbedo = { type = \"checker\", colour = 1 }", "unknown field `colour`"),
         ("type = \"diffuse\"\nalbedo = \"red\"", "scene.toml:3:10"),
+        (
+            "type = \"conductor\"\nalpha = 0.2\ndistribution = \"phong\"",
+            "scene.toml:4:16: unknown variant `phong`, expected `ggx` or `beckmann`",
+        ),
+        ("type = \"plastic\"\ndistribution = \"ggx\"", "scene.toml:3:1: unknown key `distribution`"),
     ];
     for (body, want) in cases {
         let e = material(body).unwrap_err();
         assert!(e.contains(want), "{body:?}: got {e:?}, want {want:?}");
+    }
+}
+
+/// `distribution` selects the microfacets of conductors and dielectrics, GGX by default.
+#[test]
+fn distribution_defaults_to_ggx() {
+    let distribution = |body: &str| match material(body).unwrap() {
+        BsdfDesc::Conductor { distribution, .. } | BsdfDesc::Dielectric { distribution, .. } => {
+            distribution
+        }
+        other => panic!("{other:?}"),
+    };
+    for (body, want) in [
+        ("type = \"conductor\"\nalpha = 0.2", MicrofacetDesc::Ggx),
+        (
+            "type = \"conductor\"\nalpha = 0.2\ndistribution = \"ggx\"",
+            MicrofacetDesc::Ggx,
+        ),
+        (
+            "type = \"conductor\"\nalpha = 0.2\ndistribution = \"beckmann\"",
+            MicrofacetDesc::Beckmann,
+        ),
+        ("type = \"dielectric\"\nalpha = 0.1", MicrofacetDesc::Ggx),
+        (
+            "type = \"dielectric\"\nalpha_u = 0.1\nalpha_v = 0.3\ndistribution = \"beckmann\"",
+            MicrofacetDesc::Beckmann,
+        ),
+    ] {
+        assert_eq!(distribution(body), want, "{body:?}");
     }
 }
 

@@ -1,10 +1,10 @@
-//! Metals: smooth (a perfect mirror) or rough (GGX microfacets), with the complex Fresnel
-//! reflectance of a conductor per RGB channel.
+//! Metals: smooth (a perfect mirror) or rough (GGX or Beckmann microfacets), with the
+//! complex Fresnel reflectance of a conductor per RGB channel.
 
 use glam::{Vec2, Vec3};
 
 use super::fresnel::{fresnel_conductor, fresnel_schlick, reflect};
-use super::microfacet::TrowbridgeReitz;
+use super::microfacet::{Microfacet, MicrofacetDistribution};
 use super::{BsdfFlags, BsdfSample};
 
 /// How a conductor's reflectance depends on the angle.
@@ -27,12 +27,13 @@ impl ConductorFresnel {
 }
 
 /// A conductor: a delta mirror when the distribution is [effectively
-/// smooth](TrowbridgeReitz::effectively_smooth), otherwise the Torrance–Sparrow GGX BRDF
-/// D·G·F/(4 cos θo cos θi) sampled by visible normals (pbrt-v4 §9.6.4). Reflection only;
-/// `wo` must lie in the upper hemisphere (the [`super::Lobe`] mirrors the back side).
+/// smooth](MicrofacetDistribution::effectively_smooth), otherwise the Torrance–Sparrow
+/// BRDF D·G·F/(4 cos θo cos θi) sampled by visible normals (pbrt-v4 §9.6.4). Reflection
+/// only; `wo` must lie in the upper hemisphere (the [`super::Lobe`] mirrors the back
+/// side).
 #[derive(Clone, Copy, Debug)]
 pub struct Conductor {
-    pub distrib: TrowbridgeReitz,
+    pub distrib: Microfacet,
     pub fresnel: ConductorFresnel,
 }
 

@@ -4,7 +4,7 @@
 use glam::{Vec2, Vec3};
 
 use super::fresnel::{fresnel_dielectric, reflect, refract};
-use super::microfacet::TrowbridgeReitz;
+use super::microfacet::{Microfacet, MicrofacetDistribution};
 use super::{BsdfFlags, BsdfSample};
 
 /// An interface between the outside (the side the normal points to) and a medium of
@@ -19,7 +19,7 @@ use super::{BsdfFlags, BsdfSample};
 #[derive(Clone, Copy, Debug)]
 pub struct Dielectric {
     pub eta: f32,
-    pub distrib: TrowbridgeReitz,
+    pub distrib: Microfacet,
     pub tint: Vec3,
 }
 
@@ -200,7 +200,7 @@ mod tests {
             for eta in [1.5, 1.0 / 1.5] {
                 let clear = Dielectric {
                     eta,
-                    distrib: TrowbridgeReitz::new(alpha, alpha),
+                    distrib: Microfacet::ggx(alpha, alpha),
                     tint: Vec3::ONE,
                 };
                 let tinted = Dielectric { tint, ..clear };

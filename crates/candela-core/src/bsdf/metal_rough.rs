@@ -5,7 +5,7 @@ use std::f32::consts::FRAC_1_PI;
 use glam::{Vec2, Vec3};
 
 use super::fresnel::{fresnel_schlick, reflect};
-use super::microfacet::TrowbridgeReitz;
+use super::microfacet::{MicrofacetDistribution, TrowbridgeReitz};
 use super::{BsdfFlags, BsdfSample};
 use crate::sampling::{cosine_hemisphere_pdf, sample_cosine_hemisphere};
 

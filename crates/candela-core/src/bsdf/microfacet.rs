@@ -1,14 +1,127 @@
-//! The anisotropic Trowbridge–Reitz (GGX) microfacet distribution with Smith's
-//! height-correlated masking-shadowing, sampled through its visible normals.
+//! Microfacet distributions for the rough conductor and dielectric: the anisotropic
+//! Trowbridge–Reitz (GGX) and Beckmann distributions, each with Smith's
+//! height-correlated masking-shadowing and sampled through its visible normals.
 //!
 //! Walter et al. 2007, "Microfacet Models for Refraction through Rough Surfaces"; Heitz
 //! 2014, "Understanding the Masking-Shadowing Function in Microfacet-Based BRDFs";
-//! Heitz 2018, "Sampling the GGX Distribution of Visible Normals". Same layout as
-//! pbrt-v4's `TrowbridgeReitzDistribution` (§9.6).
+//! Heitz 2018, "Sampling the GGX Distribution of Visible Normals"; Beckmann's sampler in
+//! [`beckmann`]. Same layout as pbrt-v4's `TrowbridgeReitzDistribution` (§9.6).
 
 use std::f32::consts::PI;
 
 use glam::{Vec2, Vec3};
+
+pub mod beckmann;
+
+pub use beckmann::Beckmann;
+
+/// Below this α (on both axes) a distribution is treated as a perfect mirror (delta):
+/// f32 cannot resolve the lobe any more.
+pub const SMOOTH_ALPHA: f32 = 1e-3;
+
+/// What the microfacet BSDFs ask of a distribution of normals, in the local frame
+/// (normal +z). A distribution gives D, Smith's Λ and a visible-normal sampler; masking
+/// and the visible-normal density follow from those.
+pub trait MicrofacetDistribution {
+    /// Roughness α along the local x axis (the shading frame's tangent) and along y.
+    fn alpha(&self) -> (f32, f32);
+
+    /// Microfacet normal density D(ωm), normalized so ∫D(ωm) cos θm dωm = 1.
+    fn d(&self, wm: Vec3) -> f32;
+
+    /// Smith's auxiliary function Λ(ω): masking of the direction is 1/(1 + Λ(ω)).
+    /// Even in ω (the same from below).
+    fn lambda(&self, w: Vec3) -> f32;
+
+    /// Samples a visible normal seen from `w` (either hemisphere: `w` is mirrored to the
+    /// upper one, −`w`) with density [`Self::d_visible`].
+    fn sample_wm(&self, w: Vec3, u: Vec2) -> Vec3;
+
+    fn effectively_smooth(&self) -> bool {
+        let (ax, ay) = self.alpha();
+        ax.max(ay) < SMOOTH_ALPHA
+    }
+
+    /// Masking of one direction, G₁(ω) = 1/(1 + Λ(ω)).
+    fn g1(&self, w: Vec3) -> f32 {
+        1.0 / (1.0 + self.lambda(w))
+    }
+
+    /// Height-correlated masking-shadowing G(ωo, ωi) = 1/(1 + Λ(ωo) + Λ(ωi)).
+    fn g(&self, wo: Vec3, wi: Vec3) -> f32 {
+        1.0 / (1.0 + self.lambda(wo) + self.lambda(wi))
+    }
+
+    /// Density of visible normals from `w`: G₁(ω)/|cos θ| · D(ωm) · |ω·ωm| (Heitz 2014,
+    /// eq. 38); back-facing normals are invisible. From below (`w.z < 0`) the surface is
+    /// seen mirrored, as [`Self::sample_wm`] samples it: the density is that seen from
+    /// −`w`, so a normal is visible where ω·ωm has the sign of cos θ. Integrates to 1
+    /// over ωm from either side.
+    fn d_visible(&self, w: Vec3, wm: Vec3) -> f32 {
+        if w.z == 0.0 {
+            return 0.0;
+        }
+        let cos_m = w.dot(wm) * w.z.signum();
+        self.g1(w) / w.z.abs() * self.d(wm) * cos_m.max(0.0)
+    }
+}
+
+/// The distribution of a rough conductor or dielectric: a closed enum, matched once per
+/// query (every method dispatches to the variant's own, so GGX computes exactly what
+/// [`TrowbridgeReitz`] does alone).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Microfacet {
+    Ggx(TrowbridgeReitz),
+    Beckmann(Beckmann),
+}
+
+macro_rules! dispatch {
+    ($self:ident, $m:ident => $e:expr) => {
+        match $self {
+            Microfacet::Ggx($m) => $e,
+            Microfacet::Beckmann($m) => $e,
+        }
+    };
+}
+
+impl Microfacet {
+    /// GGX of roughness α along x and y.
+    pub fn ggx(alpha_x: f32, alpha_y: f32) -> Microfacet {
+        Microfacet::Ggx(TrowbridgeReitz::new(alpha_x, alpha_y))
+    }
+
+    /// Beckmann of roughness α along x and y.
+    pub fn beckmann(alpha_x: f32, alpha_y: f32) -> Microfacet {
+        Microfacet::Beckmann(Beckmann::new(alpha_x, alpha_y))
+    }
+}
+
+impl MicrofacetDistribution for Microfacet {
+    fn alpha(&self) -> (f32, f32) {
+        dispatch!(self, m => m.alpha())
+    }
+    fn d(&self, wm: Vec3) -> f32 {
+        dispatch!(self, m => m.d(wm))
+    }
+    fn lambda(&self, w: Vec3) -> f32 {
+        dispatch!(self, m => m.lambda(w))
+    }
+    fn sample_wm(&self, w: Vec3, u: Vec2) -> Vec3 {
+        dispatch!(self, m => m.sample_wm(w, u))
+    }
+    fn effectively_smooth(&self) -> bool {
+        dispatch!(self, m => m.effectively_smooth())
+    }
+    fn g1(&self, w: Vec3) -> f32 {
+        dispatch!(self, m => m.g1(w))
+    }
+    fn g(&self, wo: Vec3, wi: Vec3) -> f32 {
+        dispatch!(self, m => m.g(wo, wi))
+    }
+    fn d_visible(&self, w: Vec3, wm: Vec3) -> f32 {
+        dispatch!(self, m => m.d_visible(w, wm))
+    }
+}
 
 /// GGX with roughness `alpha_x` along the local x axis (the shading frame's tangent) and
 /// `alpha_y` along y. Directions are in the local frame (normal +z).
@@ -19,10 +132,6 @@ pub struct TrowbridgeReitz {
 }
 
 impl TrowbridgeReitz {
-    /// Below this α the distribution is treated as a perfect mirror (delta): f32 cannot
-    /// resolve the lobe any more.
-    pub const SMOOTH_ALPHA: f32 = 1e-3;
-
     pub fn new(alpha_x: f32, alpha_y: f32) -> Self {
         TrowbridgeReitz { alpha_x, alpha_y }
     }
@@ -31,13 +140,14 @@ impl TrowbridgeReitz {
     pub fn roughness_to_alpha(r: f32) -> f32 {
         r * r
     }
+}
 
-    pub fn effectively_smooth(&self) -> bool {
-        self.alpha_x.max(self.alpha_y) < Self::SMOOTH_ALPHA
+impl MicrofacetDistribution for TrowbridgeReitz {
+    fn alpha(&self) -> (f32, f32) {
+        (self.alpha_x, self.alpha_y)
     }
 
-    /// Microfacet normal density D(ωm), normalized so ∫D(ωm) cos θm dωm = 1.
-    pub fn d(&self, wm: Vec3) -> f32 {
+    fn d(&self, wm: Vec3) -> f32 {
         let (ax, ay) = (self.alpha_x, self.alpha_y);
         let e = (wm.x / ax).powi(2) + (wm.y / ay).powi(2) + wm.z * wm.z;
         if wm.z <= 0.0 || e == 0.0 {
@@ -46,8 +156,7 @@ impl TrowbridgeReitz {
         1.0 / (PI * ax * ay * e * e)
     }
 
-    /// Smith's auxiliary function Λ(ω).
-    pub fn lambda(&self, w: Vec3) -> f32 {
+    fn lambda(&self, w: Vec3) -> f32 {
         if w.z == 0.0 {
             return f32::INFINITY;
         }
@@ -55,32 +164,8 @@ impl TrowbridgeReitz {
         0.5 * ((1.0 + a2tan2).sqrt() - 1.0)
     }
 
-    /// Masking of one direction, G₁(ω) = 1/(1 + Λ(ω)).
-    pub fn g1(&self, w: Vec3) -> f32 {
-        1.0 / (1.0 + self.lambda(w))
-    }
-
-    /// Height-correlated masking-shadowing G(ωo, ωi) = 1/(1 + Λ(ωo) + Λ(ωi)).
-    pub fn g(&self, wo: Vec3, wi: Vec3) -> f32 {
-        1.0 / (1.0 + self.lambda(wo) + self.lambda(wi))
-    }
-
-    /// Density of visible normals from `w`: G₁(ω)/|cos θ| · D(ωm) · |ω·ωm| (Heitz 2014,
-    /// eq. 38); back-facing normals are invisible. From below (`w.z < 0`) the surface is
-    /// seen mirrored, as [`Self::sample_wm`] samples it: the density is that seen from
-    /// −`w`, so a normal is visible where ω·ωm has the sign of cos θ. Integrates to 1
-    /// over ωm from either side.
-    pub fn d_visible(&self, w: Vec3, wm: Vec3) -> f32 {
-        if w.z == 0.0 {
-            return 0.0;
-        }
-        let cos_m = w.dot(wm) * w.z.signum();
-        self.g1(w) / w.z.abs() * self.d(wm) * cos_m.max(0.0)
-    }
-
-    /// Samples a visible normal seen from `w` (either hemisphere: `w` is mirrored to the
-    /// upper one) with density [`Self::d_visible`] (Heitz 2018, listing 1).
-    pub fn sample_wm(&self, w: Vec3, u: Vec2) -> Vec3 {
+    /// Heitz 2018, listing 1.
+    fn sample_wm(&self, w: Vec3, u: Vec2) -> Vec3 {
         let mut wh = Vec3::new(self.alpha_x * w.x, self.alpha_y * w.y, w.z).normalize();
         if wh.z < 0.0 {
             wh = -wh;
@@ -108,35 +193,42 @@ impl TrowbridgeReitz {
 mod tests {
     use super::*;
 
-    /// ∫ D(ωm) cos θm dωm = 1 and ∫ D_ω(ωm) dωm = 1, by a midpoint rule in (θ, φ).
+    /// ∫ D(ωm) cos θm dωm = 1 and ∫ D_ω(ωm) dωm = 1 for both distributions, by a midpoint
+    /// rule in (θ, φ) (4000 × 256 cells; the narrowest lobe, α = 0.05, spans ~130 rows).
+    /// Tolerance 5·10⁻³: the rule's error at the thinnest α is ~10⁻³, while a wrong
+    /// normalization constant or a Λ inconsistent with D is off by percents. ω is seen
+    /// from above, from below (the mirrored view that `sample_wm` samples) and at 85°,
+    /// where Λ matters most.
     #[test]
     fn distribution_and_visible_normals_are_normalized() {
-        for (ax, ay) in [(0.5, 0.5), (0.2, 0.6), (0.05, 0.05)] {
-            let m = TrowbridgeReitz::new(ax, ay);
-            // From above, and from below (the mirrored view that `sample_wm` samples).
-            let (w, w_below) = (
-                Vec3::new(0.5, 0.2, 0.6).normalize(),
-                Vec3::new(0.5, 0.2, -0.6).normalize(),
-            );
-            let (nt, np) = (4000, 256);
-            let (mut proj, mut vis, mut vis_below) = (0.0f64, 0.0f64, 0.0f64);
-            for i in 0..nt {
-                let th = (i as f32 + 0.5) / nt as f32 * PI / 2.0;
-                for j in 0..np {
-                    let ph = (j as f32 + 0.5) / np as f32 * 2.0 * PI;
-                    let wm = Vec3::new(th.sin() * ph.cos(), th.sin() * ph.sin(), th.cos());
-                    let dw = (th.sin() * (PI / 2.0 / nt as f32) * (2.0 * PI / np as f32)) as f64;
-                    proj += (m.d(wm) * wm.z) as f64 * dw;
-                    vis += m.d_visible(w, wm) as f64 * dw;
-                    vis_below += m.d_visible(w_below, wm) as f64 * dw;
+        for (ax, ay) in [(0.5, 0.5), (0.2, 0.6), (0.05, 0.05), (1.0, 0.3)] {
+            for m in [Microfacet::ggx(ax, ay), Microfacet::beckmann(ax, ay)] {
+                let ws = [
+                    Vec3::new(0.5, 0.2, 0.6).normalize(),
+                    Vec3::new(0.5, 0.2, -0.6).normalize(),
+                    Vec3::new(85f32.to_radians().sin(), 0.0, 85f32.to_radians().cos()),
+                ];
+                let (nt, np) = (4000, 256);
+                let mut proj = 0.0f64;
+                let mut vis = [0.0f64; 3];
+                for i in 0..nt {
+                    let th = (i as f32 + 0.5) / nt as f32 * PI / 2.0;
+                    for j in 0..np {
+                        let ph = (j as f32 + 0.5) / np as f32 * 2.0 * PI;
+                        let wm = Vec3::new(th.sin() * ph.cos(), th.sin() * ph.sin(), th.cos());
+                        let dw =
+                            (th.sin() * (PI / 2.0 / nt as f32) * (2.0 * PI / np as f32)) as f64;
+                        proj += (m.d(wm) * wm.z) as f64 * dw;
+                        for (v, w) in vis.iter_mut().zip(ws) {
+                            *v += m.d_visible(w, wm) as f64 * dw;
+                        }
+                    }
+                }
+                assert!((proj - 1.0).abs() < 5e-3, "{m:?}: ∫D cos = {proj}");
+                for (v, w) in vis.iter().zip(ws) {
+                    assert!((v - 1.0).abs() < 5e-3, "{m:?}: ∫D_ω = {v} from ω = {w}");
                 }
             }
-            assert!((proj - 1.0).abs() < 5e-3, "α=({ax},{ay}): ∫D cos = {proj}");
-            assert!((vis - 1.0).abs() < 5e-3, "α=({ax},{ay}): ∫D_ω = {vis}");
-            assert!(
-                (vis_below - 1.0).abs() < 5e-3,
-                "α=({ax},{ay}): ∫D_ω from below = {vis_below}"
-            );
         }
     }
 }

@@ -38,7 +38,7 @@ pub use conductor::{metal_preset, Conductor, ConductorFresnel, METAL_PRESETS};
 pub use dielectric::{Dielectric, ThinDielectric};
 pub use diffuse::Diffuse;
 pub use metal_rough::MetalRough;
-pub use microfacet::TrowbridgeReitz;
+pub use microfacet::{Beckmann, Microfacet, MicrofacetDistribution, TrowbridgeReitz};
 pub use plastic::Plastic;
 
 use glam::{Vec2, Vec3};

@@ -25,7 +25,8 @@ use std::sync::Arc;
 
 use candela_core::alpha::AlphaMode;
 use candela_core::desc::{
-    AlphaDesc, BsdfDesc, ImageDesc, ImageTextureDesc, MaterialDesc, TextureDesc, WrapMode,
+    AlphaDesc, BsdfDesc, ImageDesc, ImageTextureDesc, MaterialDesc, MicrofacetDesc, TextureDesc,
+    WrapMode,
 };
 use glam::{Affine2, Mat2, Vec2, Vec3};
 
@@ -136,6 +137,7 @@ impl Materials {
                 eta: ior,
                 alpha_u: alpha,
                 alpha_v: alpha,
+                distribution: MicrofacetDesc::Ggx,
                 thin: false,
                 tint: base_color,
             }

@@ -3,7 +3,7 @@
 //! so an unwrapped one becomes [`BsdfDesc::OneSided`]. Dielectrics are two-sided in both.
 
 use candela_core::bsdf::metal_preset;
-use candela_core::desc::{BsdfDesc, MaterialDesc, TextureDesc};
+use candela_core::desc::{BsdfDesc, MaterialDesc, MicrofacetDesc, TextureDesc};
 use glam::Vec3;
 
 use super::parse::Node;
@@ -88,24 +88,26 @@ fn two_sided(ctx: &mut Ctx, node: &Node) -> Result<BsdfDesc, LoadError> {
         },
         "conductor" | "roughconductor" => {
             let (eta, k) = conductor_ior(ctx, node)?;
-            let (alpha_u, alpha_v) = roughness(ctx, node, kind == "roughconductor")?;
+            let (alpha_u, alpha_v, distribution) = roughness(node, kind == "roughconductor")?;
             unit_only(ctx, node, "specular_reflectance")?;
             BsdfDesc::Conductor {
                 eta,
                 k,
                 alpha_u,
                 alpha_v,
+                distribution,
             }
         }
         "dielectric" | "roughdielectric" | "thindielectric" => {
             let eta = ior(node, "int_ior", 1.5046)? / ior(node, "ext_ior", 1.000277)?;
-            let (alpha_u, alpha_v) = roughness(ctx, node, kind == "roughdielectric")?;
+            let (alpha_u, alpha_v, distribution) = roughness(node, kind == "roughdielectric")?;
             unit_only(ctx, node, "specular_reflectance")?;
             unit_only(ctx, node, "specular_transmittance")?;
             BsdfDesc::Dielectric {
                 eta,
                 alpha_u,
                 alpha_v,
+                distribution,
                 thin: kind == "thindielectric",
                 tint: TextureDesc::Constant(Vec3::ONE),
             }
@@ -113,7 +115,7 @@ fn two_sided(ctx: &mut Ctx, node: &Node) -> Result<BsdfDesc, LoadError> {
         "plastic" | "roughplastic" => {
             let eta = ior(node, "int_ior", 1.49)? / ior(node, "ext_ior", 1.000277)?;
             if kind == "roughplastic" {
-                roughness(ctx, node, true)?;
+                roughness(node, true)?;
                 ctx.warn(
                     node,
                     "roughplastic: Candela's plastic has a smooth coat, so the highlight is \
@@ -232,42 +234,34 @@ fn ior(node: &Node, name: &str, default: f32) -> Result<f32, LoadError> {
     Ok(ior)
 }
 
-/// GGX α along u and v: `alpha` (default 0.1, as Mitsuba), or `alpha_u` and `alpha_v`;
-/// zero for the smooth variants.
-fn roughness(ctx: &mut Ctx, node: &Node, rough: bool) -> Result<(f32, f32), LoadError> {
+/// The microfacet α along u and v, `alpha` (default 0.1, as Mitsuba) or `alpha_u` and
+/// `alpha_v`, and the `distribution` (default beckmann, as Mitsuba); α is zero for the
+/// smooth variants, whose distribution does not matter.
+fn roughness(node: &Node, rough: bool) -> Result<(f32, f32, MicrofacetDesc), LoadError> {
     if !rough {
-        return Ok((0.0, 0.0));
+        return Ok((0.0, 0.0, MicrofacetDesc::Beckmann));
     }
-    // Mitsuba's default distribution is beckmann, so leaving it out asks for it too.
-    match node.string("distribution")? {
-        Some("ggx") => {}
-        None => ctx.warn(
-            node,
-            "Candela's microfacets are GGX: Mitsuba's default distribution, beckmann, is \
-             rendered as GGX of the same alpha (give distribution=\"ggx\" to match)",
-        ),
-        Some("beckmann") => ctx.warn(
-            node,
-            "Candela's microfacets are GGX: the beckmann distribution is rendered as GGX of \
-             the same alpha",
-        ),
+    let distribution = match node.string("distribution")? {
+        None | Some("beckmann") => MicrofacetDesc::Beckmann,
+        Some("ggx") => MicrofacetDesc::Ggx,
         Some(d) => {
             let p = node.prop("distribution").expect("read just now");
             return Err(p.error(format!(
                 "unknown microfacet distribution \"{d}\" (ggx or beckmann)"
             )));
         }
-    }
+    };
     // Candela always samples visible normals; the flag changes noise, not the image.
     node.boolean("sample_visible")?;
     let alpha = node.float("alpha")?;
     let (u, v) = (node.float("alpha_u")?, node.float("alpha_v")?);
-    Ok(match (alpha, u, v) {
+    let (u, v) = match (alpha, u, v) {
         (Some(a), None, None) => (a, a),
         (None, Some(u), Some(v)) => (u, v),
         (None, None, None) => (0.1, 0.1),
         _ => return Err(node.error("give alpha, or both alpha_u and alpha_v")),
-    })
+    };
+    Ok((u, v, distribution))
 }
 
 /// A colour Candela's BSDF cannot scale by: accepted only where it is 1 (the default).
