@@ -1,16 +1,20 @@
-//! A leaf's primitives as one block of four lanes, coordinates side by side
-//! (structure of arrays), so that the watertight test runs on four triangles at once.
+//! A leaf's primitives as one block of eight lanes, coordinates side by side
+//! (structure of arrays), so that the watertight test runs on eight triangles at once:
+//! one AVX2 register where the CPU has it, two SSE halves otherwise (the second skipped
+//! when the block holds four or fewer, or when an any-hit query's first half hit).
 //!
-//! The four-lane test performs exactly the operations of [`WatertightRay::intersect`] in
+//! The vector test performs exactly the operations of [`WatertightRay::intersect`] in
 //! the same order (Rust never fuses a multiply and an add on its own), so each lane's
 //! distance and barycentrics are the same bits as the scalar test's. Lanes where an edge
 //! function is exactly zero take the scalar test, which retries those in double precision
 //! as the paper does. Blocks holding a sphere or a filtered triangle take the scalar path
 //! lane by lane, and so does everything under [`Simd::Scalar`], the reference the tests
-//! compare the four-lane path against.
+//! compare the vector paths against.
 
 use glam::Vec3;
 
+#[cfg(target_arch = "x86_64")]
+use super::lanes::Wide;
 #[cfg(doc)]
 use crate::bvh::Simd;
 use crate::geometry::{intersect_sphere, Ray, TriangleHit, WatertightRay};
@@ -19,15 +23,23 @@ pub const SPHERE: u32 = 1 << 31;
 pub const FILTERED: u32 = 1 << 30;
 pub const ID_MASK: u32 = FILTERED - 1;
 
-/// Up to four primitives. `v[vertex][axis][lane]`; a sphere lane holds its centre in
+/// Primitives a block holds: what the build's leaves are sized for.
+pub const LANES: usize = 8;
+
+/// Which test [`Block::intersect`] runs on blocks of plain triangles.
+pub const SCALAR: u8 = 0;
+pub const SSE: u8 = 1;
+pub const AVX2: u8 = 2;
+
+/// Up to eight primitives. `v[vertex][axis][lane]`; a sphere lane holds its centre in
 /// vertex 0 and its radius in vertex 1's x. `id[lane]` is the primitive index with the
-/// flag bits; unused lanes have NaN vertices, which no test hits, and id 0. 160 bytes,
-/// aligned so that each block spans three cache lines, not four.
+/// flag bits; unused lanes have NaN vertices, which no test hits, and id 0. 320 bytes,
+/// five cache lines (the ids in the last), each row of eight floats one aligned load.
 #[derive(Clone, Copy, Debug)]
-#[repr(C, align(32))]
+#[repr(C, align(64))]
 pub struct Block {
-    v: [[[f32; 4]; 3]; 3],
-    id: [u32; 4],
+    v: [[[f32; LANES]; 3]; 3],
+    id: [u32; LANES],
 }
 
 /// The nearest hit in a block: lane, and the triangle test's result.
@@ -36,13 +48,22 @@ pub struct LaneHit {
     pub hit: TriangleHit,
 }
 
+/// The vector test's per-lane results, written only for registers that hit something
+/// and read only in lanes that did.
+#[cfg(target_arch = "x86_64")]
+struct Lanes {
+    t: [f32; LANES],
+    b1: [f32; LANES],
+    b2: [f32; LANES],
+}
+
 impl Block {
-    /// Packs up to four primitives given as (vertices, id with flags).
+    /// Packs up to eight primitives given as (vertices, id with flags).
     pub fn new(prims: &[([Vec3; 3], u32)]) -> Block {
-        debug_assert!(prims.len() <= 4);
+        debug_assert!(prims.len() <= LANES);
         let mut b = Block {
-            v: [[[f32::NAN; 4]; 3]; 3],
-            id: [0; 4],
+            v: [[[f32::NAN; LANES]; 3]; 3],
+            id: [0; LANES],
         };
         for (lane, (v, id)) in prims.iter().enumerate() {
             for (vertex, p) in v.iter().enumerate() {
@@ -60,19 +81,20 @@ impl Block {
         Vec3::new(v[0][lane], v[1][lane], v[2][lane])
     }
 
-    /// Whether every lane is an unfiltered triangle (the four-lane path).
+    /// Whether every lane is an unfiltered triangle (the vector path).
     #[inline(always)]
     fn plain(&self) -> bool {
-        (self.id[0] | self.id[1] | self.id[2] | self.id[3]) & (SPHERE | FILTERED) == 0
+        self.id.iter().fold(0, |a, &b| a | b) & (SPHERE | FILTERED) == 0
     }
 
     /// The nearest hit among the first `count` lanes within (0, t_max) that `filter`
     /// accepts (asked only for flagged triangles). Spheres report zero barycentrics.
-    /// `SIMD` chooses the four-lane test for plain blocks (x86-64 only). With `ANY`, the
-    /// first hit found is returned, not the nearest, and from the four-lane test without
-    /// barycentrics (a shadow ray needs only whether).
+    /// `KERNEL` chooses the vector test for plain blocks ([`SSE`], [`AVX2`]: x86-64
+    /// only, and the CPU must have it). With `ANY`, the first hit found is returned, not
+    /// the nearest, and from the vector test without barycentrics (a shadow ray needs
+    /// only whether).
     #[inline(always)]
-    pub fn intersect<const SIMD: bool, const ANY: bool>(
+    pub fn intersect<const KERNEL: u8, const ANY: bool>(
         &self,
         ray: &Ray,
         wray: &WatertightRay,
@@ -81,9 +103,9 @@ impl Block {
         filter: &impl Fn(u32, &TriangleHit) -> bool,
     ) -> Option<LaneHit> {
         #[cfg(target_arch = "x86_64")]
-        if SIMD && self.plain() {
-            // SAFETY: SSE is part of the x86-64 baseline.
-            return unsafe { self.intersect4_sse::<ANY>(wray, count, t_max) };
+        if KERNEL != SCALAR && self.plain() {
+            // SAFETY: SSE is part of the x86-64 baseline, and the caller vouches for AVX2.
+            return unsafe { self.intersect_lanes::<KERNEL, ANY>(wray, count, t_max) };
         }
         let mut best = None;
         let mut t_max = t_max;
@@ -116,157 +138,164 @@ impl Block {
         best
     }
 
-    /// [`WatertightRay::intersect`] on four lanes; the nearest hit, the lowest lane
-    /// among equals (as a sequential loop that narrows `t_max` would find).
+    /// The vector test of a plain block: the nearest hit, the lowest lane among equals
+    /// (as a sequential loop that narrows `t_max` would find).
+    ///
+    /// # Safety
+    /// The CPU must support `KERNEL`.
     #[cfg(target_arch = "x86_64")]
     #[inline(always)]
-    unsafe fn intersect4_sse<const ANY: bool>(
+    unsafe fn intersect_lanes<const KERNEL: u8, const ANY: bool>(
         &self,
         w: &WatertightRay,
         count: u32,
         t_max: f32,
     ) -> Option<LaneHit> {
-        use std::arch::x86_64::*;
+        use std::arch::x86_64::{__m128, __m256};
+        use std::mem::MaybeUninit;
+        let used = (1u32 << count) - 1;
+        let mut out = MaybeUninit::<Lanes>::uninit();
+        let out = out.as_mut_ptr();
+        let (hit, edge) = if KERNEL == AVX2 {
+            self.test_lanes::<__m256, ANY>(w, 0, used, t_max, out)
+        } else {
+            let (h0, e0) = self.test_lanes::<__m128, ANY>(w, 0, used & 15, t_max, out);
+            if count <= 4 || (ANY && h0 != 0) {
+                (h0, e0)
+            } else {
+                let (h1, e1) = self.test_lanes::<__m128, ANY>(w, 4, used >> 4, t_max, out);
+                (h0 | h1, e0 | e1)
+            }
+        };
+        if hit | edge == 0 {
+            return None;
+        }
+        // SAFETY: `test_lanes` wrote `t` (and without `ANY`, `b1` and `b2`) in every
+        // register that has a `hit` bit.
+        let lane_of = |row: *const [f32; LANES], lane: usize| unsafe { (*row)[lane] };
+        let t = |lane| lane_of(std::ptr::addr_of!((*out).t), lane);
+        if ANY && hit != 0 {
+            // Some lane is hit; a shadow ray needs no more (nor the barycentrics).
+            let lane = hit.trailing_zeros() as usize;
+            return Some(LaneHit {
+                id: self.id[lane] & ID_MASK,
+                hit: TriangleHit {
+                    t: t(lane),
+                    b1: 0.0,
+                    b2: 0.0,
+                },
+            });
+        }
+        let mut best = None;
+        let mut best_t = t_max;
+        let mut todo = hit | edge;
+        while todo != 0 {
+            let lane = todo.trailing_zeros() as usize;
+            todo &= todo - 1;
+            let found = if edge & (1 << lane) != 0 {
+                let [p0, p1, p2] = [0, 1, 2].map(|k| self.vertex(k, lane));
+                w.intersect(p0, p1, p2, best_t)
+            } else if t(lane) < best_t {
+                Some(TriangleHit {
+                    t: t(lane),
+                    b1: lane_of(std::ptr::addr_of!((*out).b1), lane),
+                    b2: lane_of(std::ptr::addr_of!((*out).b2), lane),
+                })
+            } else {
+                None
+            };
+            if let Some(h) = found {
+                best_t = h.t;
+                best = Some(LaneHit {
+                    id: self.id[lane] & ID_MASK,
+                    hit: h,
+                });
+                if ANY {
+                    break;
+                }
+            }
+        }
+        best
+    }
+
+    /// [`WatertightRay::intersect`] on the `V::LANES` lanes from `first` on, those in
+    /// `used` (bit 0 = lane `first`): which are hit without an exactly-zero edge
+    /// function, and which have one (for the scalar retry), as bits of the block's
+    /// lanes. Where some lane is either, the distances (and without `ANY` the
+    /// barycentrics) go to `out`.
+    ///
+    /// # Safety
+    /// The CPU must support `V`; `first + V::LANES <= LANES`.
+    #[cfg(target_arch = "x86_64")]
+    #[inline(always)]
+    unsafe fn test_lanes<V: Wide, const ANY: bool>(
+        &self,
+        w: &WatertightRay,
+        first: usize,
+        used: u32,
+        t_max: f32,
+        out: *mut Lanes,
+    ) -> (u32, u32) {
+        debug_assert!(first + V::LANES <= LANES);
         let (kx, ky, kz) = (w.kx, w.ky, w.kz);
-        let o = w.o.to_array();
-        let (ox, oy, oz) = (_mm_set1_ps(o[kx]), _mm_set1_ps(o[ky]), _mm_set1_ps(o[kz]));
+        let (ox, oy, oz) = (V::splat(w.o_k.x), V::splat(w.o_k.y), V::splat(w.o_k.z));
         let (sx, sy, sz) = (
-            _mm_set1_ps(w.shear.x),
-            _mm_set1_ps(w.shear.y),
-            _mm_set1_ps(w.shear.z),
+            V::splat(w.shear.x),
+            V::splat(w.shear.y),
+            V::splat(w.shear.z),
         );
-        // Vertex relative to the origin, sheared: (x, y) and the unscaled z. (A macro:
-        // closures here were left out of line, three calls a block.)
+        // Vertex relative to the origin, sheared: (x, y) and the unscaled z. (A macro,
+        // not a closure: a closure would not be compiled for AVX2, nor its loads inline.)
         macro_rules! rel {
             ($vertex:expr) => {{
-                let ld = |axis: usize| _mm_load_ps(self.v[$vertex][axis].as_ptr());
-                let z = _mm_sub_ps(ld(kz), oz);
-                let x = _mm_sub_ps(_mm_sub_ps(ld(kx), ox), _mm_mul_ps(sx, z));
-                let y = _mm_sub_ps(_mm_sub_ps(ld(ky), oy), _mm_mul_ps(sy, z));
+                // SAFETY: `WatertightRay::new` makes every axis index below 3.
+                let row = |axis: usize| self.v[$vertex].get_unchecked(axis).as_ptr().add(first);
+                let z = V::load(row(kz)).sub(oz);
+                let x = V::load(row(kx)).sub(ox).sub(sx.mul(z));
+                let y = V::load(row(ky)).sub(oy).sub(sy.mul(z));
                 (x, y, z)
             }};
         }
         let (ax, ay, a_z) = rel!(0);
         let (bx, by, b_z) = rel!(1);
         let (cx, cy, c_z) = rel!(2);
-        let u = _mm_sub_ps(_mm_mul_ps(cx, by), _mm_mul_ps(cy, bx));
-        let v = _mm_sub_ps(_mm_mul_ps(ax, cy), _mm_mul_ps(ay, cx));
-        let ww = _mm_sub_ps(_mm_mul_ps(bx, ay), _mm_mul_ps(by, ax));
-        let zero = _mm_setzero_ps();
-        let used = (1u32 << count) - 1;
-        let on_edge = _mm_or_ps(
-            _mm_or_ps(_mm_cmpeq_ps(u, zero), _mm_cmpeq_ps(v, zero)),
-            _mm_cmpeq_ps(ww, zero),
-        );
-        let on_edge = _mm_movemask_ps(on_edge) as u32 & used;
-        let any_neg = _mm_or_ps(
-            _mm_or_ps(_mm_cmplt_ps(u, zero), _mm_cmplt_ps(v, zero)),
-            _mm_cmplt_ps(ww, zero),
-        );
-        let any_pos = _mm_or_ps(
-            _mm_or_ps(_mm_cmpgt_ps(u, zero), _mm_cmpgt_ps(v, zero)),
-            _mm_cmpgt_ps(ww, zero),
-        );
-        let det = _mm_add_ps(_mm_add_ps(u, v), ww);
-        let t_scaled = _mm_add_ps(
-            _mm_add_ps(
-                _mm_mul_ps(u, _mm_mul_ps(sz, a_z)),
-                _mm_mul_ps(v, _mm_mul_ps(sz, b_z)),
-            ),
-            _mm_mul_ps(ww, _mm_mul_ps(sz, c_z)),
-        );
-        let t_max4 = _mm_set1_ps(t_max);
-        let limit = _mm_mul_ps(t_max4, det);
-        let bad_neg = _mm_and_ps(
-            _mm_cmplt_ps(det, zero),
-            _mm_or_ps(_mm_cmpge_ps(t_scaled, zero), _mm_cmplt_ps(t_scaled, limit)),
-        );
-        let bad_pos = _mm_and_ps(
-            _mm_cmpgt_ps(det, zero),
-            _mm_or_ps(_mm_cmple_ps(t_scaled, zero), _mm_cmpgt_ps(t_scaled, limit)),
-        );
-        let inv_det = _mm_div_ps(_mm_set1_ps(1.0), det);
-        let t = _mm_mul_ps(t_scaled, inv_det);
-        let rejected = _mm_or_ps(
-            _mm_or_ps(_mm_and_ps(any_neg, any_pos), _mm_cmpeq_ps(det, zero)),
-            _mm_or_ps(bad_neg, bad_pos),
-        );
-        let in_range = _mm_and_ps(_mm_cmpgt_ps(t, zero), _mm_cmplt_ps(t, t_max4));
-        let ok = _mm_andnot_ps(rejected, in_range);
-        let mask = _mm_movemask_ps(ok) as u32 & used & !on_edge;
-        if mask == 0 && on_edge == 0 {
-            return None;
+        let u = cx.mul(by).sub(cy.mul(bx));
+        let v = ax.mul(cy).sub(ay.mul(cx));
+        let ww = bx.mul(ay).sub(by.mul(ax));
+        let zero = V::splat(0.0);
+        let on_edge = u.eq(zero).or(v.eq(zero)).or(ww.eq(zero)).bits() & used;
+        let any_neg = u.lt(zero).or(v.lt(zero)).or(ww.lt(zero));
+        let any_pos = u.gt(zero).or(v.gt(zero)).or(ww.gt(zero));
+        let det = u.add(v).add(ww);
+        let t_scaled = u
+            .mul(sz.mul(a_z))
+            .add(v.mul(sz.mul(b_z)))
+            .add(ww.mul(sz.mul(c_z)));
+        let t_max_v = V::splat(t_max);
+        let limit = t_max_v.mul(det);
+        let bad_neg = det
+            .lt(zero)
+            .and(t_scaled.ge(zero).or(t_scaled.lt(limit)));
+        let bad_pos = det
+            .gt(zero)
+            .and(t_scaled.le(zero).or(t_scaled.gt(limit)));
+        let inv_det = V::splat(1.0).div(det);
+        let t = t_scaled.mul(inv_det);
+        let rejected = any_neg
+            .and(any_pos)
+            .or(det.eq(zero))
+            .or(bad_neg.or(bad_pos));
+        let in_range = t.gt(zero).and(t.lt(t_max_v));
+        let hit = rejected.andnot(in_range).bits() & used & !on_edge;
+        if hit | on_edge == 0 {
+            return (0, 0);
         }
-        let mut ts = [0.0f32; 4];
-        _mm_storeu_ps(ts.as_mut_ptr(), t);
-        if ANY && mask != 0 {
-            // Some lane is hit; a shadow ray needs no more (nor the barycentrics).
-            let lane = mask.trailing_zeros() as usize;
-            return Some(LaneHit {
-                id: self.id[lane] & ID_MASK,
-                hit: TriangleHit {
-                    t: ts[lane],
-                    b1: 0.0,
-                    b2: 0.0,
-                },
-            });
+        let row = |r: *mut [f32; LANES]| (r as *mut f32).add(first);
+        t.store(row(std::ptr::addr_of_mut!((*out).t)));
+        if !ANY {
+            v.mul(inv_det).store(row(std::ptr::addr_of_mut!((*out).b1)));
+            ww.mul(inv_det).store(row(std::ptr::addr_of_mut!((*out).b2)));
         }
-        if on_edge == 0 {
-            // The nearest lane without a loop: the minimum of the hit lanes' distances
-            // (misses at +∞), then the lowest lane that has it.
-            let tm = _mm_or_ps(
-                _mm_and_ps(ok, t),
-                _mm_andnot_ps(ok, _mm_set1_ps(f32::INFINITY)),
-            );
-            let m = _mm_min_ps(tm, _mm_shuffle_ps::<0b10_11_00_01>(tm, tm));
-            let m = _mm_min_ps(m, _mm_shuffle_ps::<0b01_00_11_10>(m, m));
-            let lane = (_mm_movemask_ps(_mm_cmpeq_ps(tm, m)) as u32 & mask).trailing_zeros();
-            let lane = lane as usize;
-            let mut vs = [0.0f32; 4];
-            let mut ws = [0.0f32; 4];
-            _mm_storeu_ps(vs.as_mut_ptr(), _mm_mul_ps(v, inv_det));
-            _mm_storeu_ps(ws.as_mut_ptr(), _mm_mul_ps(ww, inv_det));
-            return Some(LaneHit {
-                id: self.id[lane] & ID_MASK,
-                hit: TriangleHit {
-                    t: ts[lane],
-                    b1: vs[lane],
-                    b2: ws[lane],
-                },
-            });
-        }
-        let mut best: Option<(usize, TriangleHit)> = None;
-        let mut best_t = t_max;
-        for (lane, &t_lane) in ts.iter().enumerate().take(count as usize) {
-            let hit = if on_edge & (1 << lane) != 0 {
-                let [p0, p1, p2] = [0, 1, 2].map(|k| self.vertex(k, lane));
-                w.intersect(p0, p1, p2, best_t)
-            } else if mask & (1 << lane) != 0 && t_lane < best_t {
-                Some(TriangleHit {
-                    t: t_lane,
-                    b1: 0.0,
-                    b2: 0.0,
-                })
-            } else {
-                None
-            };
-            if let Some(h) = hit {
-                best_t = h.t;
-                best = Some((lane, h));
-            }
-        }
-        let (lane, mut hit) = best?;
-        if on_edge & (1 << lane) == 0 {
-            let mut vs = [0.0f32; 4];
-            let mut ws = [0.0f32; 4];
-            _mm_storeu_ps(vs.as_mut_ptr(), _mm_mul_ps(v, inv_det));
-            _mm_storeu_ps(ws.as_mut_ptr(), _mm_mul_ps(ww, inv_det));
-            hit.b1 = vs[lane];
-            hit.b2 = ws[lane];
-        }
-        Some(LaneHit {
-            id: self.id[lane] & ID_MASK,
-            hit,
-        })
+        (hit << first, on_edge << first)
     }
 }
