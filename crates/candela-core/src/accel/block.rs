@@ -273,12 +273,8 @@ impl Block {
             .add(ww.mul(sz.mul(c_z)));
         let t_max_v = V::splat(t_max);
         let limit = t_max_v.mul(det);
-        let bad_neg = det
-            .lt(zero)
-            .and(t_scaled.ge(zero).or(t_scaled.lt(limit)));
-        let bad_pos = det
-            .gt(zero)
-            .and(t_scaled.le(zero).or(t_scaled.gt(limit)));
+        let bad_neg = det.lt(zero).and(t_scaled.ge(zero).or(t_scaled.lt(limit)));
+        let bad_pos = det.gt(zero).and(t_scaled.le(zero).or(t_scaled.gt(limit)));
         let inv_det = V::splat(1.0).div(det);
         let t = t_scaled.mul(inv_det);
         let rejected = any_neg
@@ -294,8 +290,169 @@ impl Block {
         t.store(row(std::ptr::addr_of_mut!((*out).t)));
         if !ANY {
             v.mul(inv_det).store(row(std::ptr::addr_of_mut!((*out).b1)));
-            ww.mul(inv_det).store(row(std::ptr::addr_of_mut!((*out).b2)));
+            ww.mul(inv_det)
+                .store(row(std::ptr::addr_of_mut!((*out).b2)));
         }
         (hit << first, on_edge << first)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::bvh::Simd;
+    use crate::sampler::Pcg32;
+
+    fn v3(rng: &mut Pcg32) -> Vec3 {
+        Vec3::new(rng.uniform_f32(), rng.uniform_f32(), rng.uniform_f32())
+    }
+
+    /// `Block::intersect` with the kernel `simd` names (which the CPU must have).
+    fn trace<const ANY: bool>(
+        simd: Simd,
+        block: &Block,
+        ray: &Ray,
+        count: u32,
+        t_max: f32,
+        filter: &impl Fn(u32, &TriangleHit) -> bool,
+    ) -> Option<(u32, [u32; 3])> {
+        #[cfg(target_arch = "x86_64")]
+        #[target_feature(enable = "avx2")]
+        unsafe fn avx2<const ANY: bool>(
+            block: &Block,
+            ray: &Ray,
+            count: u32,
+            t_max: f32,
+            filter: &impl Fn(u32, &TriangleHit) -> bool,
+        ) -> Option<LaneHit> {
+            block.intersect::<AVX2, ANY>(ray, &WatertightRay::new(ray), count, t_max, filter)
+        }
+        let w = WatertightRay::new(ray);
+        let hit = match simd {
+            Simd::Scalar => block.intersect::<SCALAR, ANY>(ray, &w, count, t_max, filter),
+            Simd::Sse => block.intersect::<SSE, ANY>(ray, &w, count, t_max, filter),
+            // SAFETY: the caller passes only kernels from `Simd::available`.
+            #[cfg(target_arch = "x86_64")]
+            Simd::Avx2 => unsafe { avx2::<ANY>(block, ray, count, t_max, filter) },
+            #[cfg(not(target_arch = "x86_64"))]
+            Simd::Avx2 => unreachable!(),
+        };
+        hit.map(|h| (h.id, [h.hit.t, h.hit.b1, h.hit.b2].map(f32::to_bits)))
+    }
+
+    /// Every fill from one lane to eight, plain blocks and blocks mixing spheres and
+    /// filtered triangles in: each kernel the CPU has returns the scalar kernel's lane,
+    /// distance and barycentrics bit for bit, and that is the nearest hit of a plain loop
+    /// over `WatertightRay::intersect` (the lowest lane among equal distances). Rays aim
+    /// at points inside the triangles, at their vertices (exactly zero edge functions:
+    /// the double-precision retry) and along the axes.
+    #[test]
+    fn every_kernel_gives_the_scalar_bits_at_every_fill() {
+        let mut rng = Pcg32::new(8, 8);
+        let simds = Simd::available();
+        let (mut hits, mut vertex_hits, mut mixed) = (0, 0, 0);
+        let accept_even = |id: u32, _: &TriangleHit| id.is_multiple_of(2);
+        for trial in 0..40000u32 {
+            let count = 1 + trial % 8;
+            let kind = |lane: u32| (trial / 8 + lane) % 11;
+            let mut prims = Vec::new();
+            // Vertices on a coarse grid half the time, so triangles share edges.
+            let grid = |v: Vec3| {
+                if trial % 2 == 0 {
+                    (v * 4.0).floor() / 4.0
+                } else {
+                    v
+                }
+            };
+            for lane in 0..count {
+                let v = [0; 3].map(|_| grid(v3(&mut rng)));
+                let flags = match kind(lane) {
+                    0 if trial % 3 == 0 => SPHERE,
+                    1 if trial % 3 == 0 => FILTERED,
+                    _ => 0,
+                };
+                let v = if flags == SPHERE {
+                    [
+                        v[0],
+                        Vec3::new(0.1 + 0.2 * rng.uniform_f32(), 0.0, 0.0),
+                        Vec3::ZERO,
+                    ]
+                } else {
+                    v
+                };
+                prims.push((v, lane | flags));
+            }
+            mixed += prims.iter().any(|p| p.1 & (SPHERE | FILTERED) != 0) as u32;
+            let block = Block::new(&prims);
+            let target = prims[rng.next_u32() as usize % count as usize].0;
+            let o = v3(&mut rng) * 3.0 - 1.0;
+            let at_vertex = trial % 4 == 0 && prims.iter().all(|p| p.1 & SPHERE == 0);
+            let aim = if at_vertex {
+                target[trial as usize / 4 % 3]
+            } else {
+                let (a, b) = (rng.uniform_f32(), rng.uniform_f32());
+                let (a, b) = if a + b > 1.0 {
+                    (1.0 - a, 1.0 - b)
+                } else {
+                    (a, b)
+                };
+                target[0] + (target[1] - target[0]) * a + (target[2] - target[0]) * b
+            };
+            let mut d = aim - o;
+            if trial % 7 == 0 {
+                d.x = 0.0;
+            }
+            let ray = Ray::new(o, d.normalize_or(Vec3::Y));
+            let t_max = if trial % 5 == 0 {
+                2.0 * rng.uniform_f32()
+            } else {
+                f32::INFINITY
+            };
+
+            let mut reference = None;
+            let mut best = t_max;
+            for (lane, (v, id)) in prims.iter().enumerate() {
+                let hit = if id & SPHERE != 0 {
+                    intersect_sphere(&ray, v[0], v[1].x, best).map(|t| TriangleHit {
+                        t,
+                        b1: 0.0,
+                        b2: 0.0,
+                    })
+                } else {
+                    WatertightRay::new(&ray)
+                        .intersect(v[0], v[1], v[2], best)
+                        .filter(|h| id & FILTERED == 0 || accept_even(lane as u32, h))
+                };
+                if let Some(h) = hit {
+                    best = h.t;
+                    reference = Some((lane as u32, [h.t, h.b1, h.b2].map(f32::to_bits)));
+                }
+            }
+            let scalar = trace::<false>(Simd::Scalar, &block, &ray, count, t_max, &accept_even);
+            assert_eq!(
+                scalar, reference,
+                "trial {trial}: scalar kernel vs a plain loop"
+            );
+            for &simd in &simds {
+                let nearest = trace::<false>(simd, &block, &ray, count, t_max, &accept_even);
+                assert_eq!(nearest, scalar, "trial {trial}: {simd:?}, {count} lanes");
+                let any = trace::<true>(simd, &block, &ray, count, t_max, &accept_even);
+                assert_eq!(
+                    any.is_some(),
+                    scalar.is_some(),
+                    "trial {trial}: {simd:?} any-hit"
+                );
+            }
+            hits += scalar.is_some() as u32;
+            vertex_hits += (at_vertex && scalar.is_some()) as u32;
+        }
+        // Thresholds: about half the rays aim inside a triangle and meet it unless
+        // something nearer or `t_max` intervenes; a quarter aim at vertices.
+        assert!(hits > 15000, "only {hits} hits");
+        assert!(vertex_hits > 2000, "only {vertex_hits} hits at vertices");
+        assert!(mixed > 3000, "only {mixed} mixed blocks");
+        eprintln!(
+            "kernels {simds:?}: {hits} hits, {vertex_hits} at vertices, {mixed} mixed blocks"
+        );
     }
 }

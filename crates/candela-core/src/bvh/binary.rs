@@ -345,7 +345,7 @@ fn build_recursive(
             best_split = i;
         }
     }
-    if small && !(best_cost + cost.node * area(&ext.bounds) < area(&ext.bounds)) {
+    if small && best_cost + cost.node * area(&ext.bounds) >= area(&ext.bounds) {
         // One block costs no more than the node and the children's blocks.
         return leaf;
     }
