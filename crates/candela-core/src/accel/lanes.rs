@@ -21,6 +21,9 @@ pub trait Wide: Copy {
     unsafe fn sub(self, o: Self) -> Self;
     unsafe fn mul(self, o: Self) -> Self;
     unsafe fn div(self, o: Self) -> Self;
+    /// `minps`/`maxps`: `o` where either is NaN.
+    unsafe fn min(self, o: Self) -> Self;
+    unsafe fn max(self, o: Self) -> Self;
     unsafe fn and(self, o: Self) -> Self;
     unsafe fn or(self, o: Self) -> Self;
     /// `!self & o`.
@@ -64,6 +67,14 @@ impl Wide for __m128 {
     #[inline(always)]
     unsafe fn div(self, o: Self) -> Self {
         _mm_div_ps(self, o)
+    }
+    #[inline(always)]
+    unsafe fn min(self, o: Self) -> Self {
+        _mm_min_ps(self, o)
+    }
+    #[inline(always)]
+    unsafe fn max(self, o: Self) -> Self {
+        _mm_max_ps(self, o)
     }
     #[inline(always)]
     unsafe fn and(self, o: Self) -> Self {
@@ -126,6 +137,8 @@ impl Wide for __m256 {
         fn sub(self: Self, o: Self) -> Self { _mm256_sub_ps(self, o) }
         fn mul(self: Self, o: Self) -> Self { _mm256_mul_ps(self, o) }
         fn div(self: Self, o: Self) -> Self { _mm256_div_ps(self, o) }
+        fn min(self: Self, o: Self) -> Self { _mm256_min_ps(self, o) }
+        fn max(self: Self, o: Self) -> Self { _mm256_max_ps(self, o) }
         fn and(self: Self, o: Self) -> Self { _mm256_and_ps(self, o) }
         fn or(self: Self, o: Self) -> Self { _mm256_or_ps(self, o) }
         fn andnot(self: Self, o: Self) -> Self { _mm256_andnot_ps(self, o) }
