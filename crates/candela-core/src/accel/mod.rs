@@ -28,6 +28,9 @@ use block::{Block, FILTERED, ID_MASK, LANES, SPHERE};
 
 pub use crate::bvh::Simd;
 
+// Every leaf of the build fits one block.
+const _: () = assert!(SahCost::BLOCKS.max_leaf == LANES);
+
 /// A primitive handed to [`Accel::build`].
 #[derive(Clone, Copy, Debug)]
 pub enum Shape {
@@ -89,7 +92,6 @@ impl Accel {
         );
         let boxes: Vec<Aabb> = shapes.iter().map(Shape::bounds).collect();
         let binary = Bvh::build_with(&boxes, SahCost::BLOCKS);
-        debug_assert_eq!(SahCost::BLOCKS.max_leaf, LANES);
         let record = |i: u32| match shapes[i as usize] {
             Shape::Triangle(v) => (v, i | if filtered(i) { FILTERED } else { 0 }),
             Shape::Sphere { center, radius } => (
