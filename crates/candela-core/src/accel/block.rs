@@ -83,7 +83,18 @@ impl Block {
 
     /// Whether every lane is an unfiltered triangle (the vector path).
     #[inline(always)]
-    fn plain(&self) -> bool {
+    fn plain<const KERNEL: u8>(&self) -> bool {
+        #[cfg(target_arch = "x86_64")]
+        if KERNEL == AVX2 {
+            use std::arch::x86_64::*;
+            // SAFETY: the AVX2 kernel runs only on CPUs that have it. One `vptest`, not
+            // an OR of eight lanes (callgrind, instructions a ray on the Cornell box:
+            // closest-hit 660 -> 651, any-hit 415 -> 409).
+            return unsafe {
+                let ids = _mm256_loadu_si256(self.id.as_ptr() as *const __m256i);
+                _mm256_testz_si256(ids, _mm256_set1_epi32((SPHERE | FILTERED) as i32)) != 0
+            };
+        }
         self.id.iter().fold(0, |a, &b| a | b) & (SPHERE | FILTERED) == 0
     }
 
@@ -103,7 +114,7 @@ impl Block {
         filter: &impl Fn(u32, &TriangleHit) -> bool,
     ) -> Option<LaneHit> {
         #[cfg(target_arch = "x86_64")]
-        if KERNEL != SCALAR && self.plain() {
+        if KERNEL != SCALAR && self.plain::<KERNEL>() {
             // SAFETY: SSE is part of the x86-64 baseline, and the caller vouches for AVX2.
             return unsafe { self.intersect_lanes::<KERNEL, ANY>(wray, count, t_max) };
         }
@@ -218,8 +229,8 @@ impl Block {
         best
     }
 
-    /// [`WatertightRay::intersect`] on the `V::LANES` lanes from `first` on, those in
-    /// `used` (bit 0 = lane `first`): which are hit without an exactly-zero edge
+    /// [`WatertightRay::intersect`] on the `V::LANES` lanes from `first` on (`used`: the
+    /// filled ones, bit 0 = lane `first`): which are hit without an exactly-zero edge
     /// function, and which have one (for the scalar retry), as bits of the block's
     /// lanes. Where some lane is either, the distances (and without `ANY` the
     /// barycentrics) go to `out`.
@@ -263,7 +274,9 @@ impl Block {
         let v = ax.mul(cy).sub(ay.mul(cx));
         let ww = bx.mul(ay).sub(by.mul(ax));
         let zero = V::splat(0.0);
-        let on_edge = u.eq(zero).or(v.eq(zero)).or(ww.eq(zero)).bits() & used;
+        // Unused lanes need no mask here: their NaN vertices give NaN edge functions and
+        // distances, which are neither zero nor in range.
+        let on_edge = u.eq(zero).or(v.eq(zero)).or(ww.eq(zero)).bits();
         // Some edge function negative and some positive: the scalar test's six
         // comparisons as the sign of the least and the greatest. (They differ only where
         // one is NaN, and there `det` and `t` are NaN too, which no lane passes.)
@@ -287,7 +300,7 @@ impl Block {
         let inv_det = V::splat(1.0).div(det);
         let t = t_scaled.mul(inv_det);
         let in_range = t.gt(zero).and(t.lt(t_max_v));
-        let hit = rejected.andnot(in_range).bits() & used & !on_edge;
+        let hit = rejected.andnot(in_range).bits() & !on_edge;
         if hit | on_edge == 0 {
             return (0, 0);
         }
