@@ -55,8 +55,9 @@ impl SahCost {
     };
 
     /// Eight-lane blocks (the scene's [`crate::accel::Accel`]). A node costs nothing
-    /// here: the collapse to eight-wide nodes absorbs binary nodes. Measured (callgrind
-    /// instructions per closest-hit ray, bench/traversal.sh's rays): a node cost of 0
+    /// here: the collapse to eight-wide nodes absorbs binary nodes. Measured with the
+    /// first eight-lane kernel (callgrind instructions per closest-hit ray,
+    /// bench/traversal.sh's rays): a node cost of 0
     /// gave 674 on the Cornell box, 0.5 gave 781, the 590k room 1606 and 1598; pricing
     /// large nodes by blocks (⌈n / 8⌉ × area) instead of primitives gave 756 at 0.
     pub const BLOCKS: SahCost = SahCost {
