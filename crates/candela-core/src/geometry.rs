@@ -116,12 +116,15 @@ pub struct TriangleHit {
 pub struct WatertightRay {
     pub(crate) o: Vec3,
     /// The axis along which the direction is largest is `kz`; `kx`, `ky` the others, in
-    /// the order that keeps the winding.
+    /// the order that keeps the winding. Each is below 3 (the vector tests index by
+    /// them unchecked).
     pub(crate) kx: usize,
     pub(crate) ky: usize,
     pub(crate) kz: usize,
     /// (d[kx]/d[kz], d[ky]/d[kz], 1/d[kz]).
     pub(crate) shear: Vec3,
+    /// (o[kx], o[ky], o[kz]): what the vector tests splat, picked once per ray.
+    pub(crate) o_k: Vec3,
 }
 
 impl WatertightRay {
@@ -150,12 +153,14 @@ impl WatertightRay {
             (dx, dy) = (dy, dx);
         }
         let sz = 1.0 / z;
+        let o = ray.o.to_array();
         WatertightRay {
             o: ray.o,
             kx,
             ky,
             kz,
             shear: Vec3::new(dx * sz, dy * sz, sz),
+            o_k: Vec3::new(o[kx], o[ky], o[kz]),
         }
     }
 

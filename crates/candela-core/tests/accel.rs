@@ -9,6 +9,10 @@
 //! The alpha-mask path: flagging every other triangle and rejecting it in the filter must
 //! give the same hits as building without those triangles.
 //!
+//! Leaves are blocks of up to eight lanes, so these scenes hold blocks of every fill, and
+//! the soup mixes spheres among its triangles (`accel::block`'s own test checks each
+//! fill and mix lane by lane).
+//!
 //! Every SIMD kernel set the CPU has (`Simd::available`, always including the scalar
 //! fallback) is checked the same way, and each must return exactly what the scalar one
 //! returns (same primitive even in ties, same t and barycentric bits): their box tests
@@ -257,6 +261,16 @@ fn same_hits_as_brute_force_and_the_binary_bvh() {
             assert!(hits > 100, "{name}: too few hits ({hits}) to test anything");
         }
     }
+    // An instance's BLAS is traced with object-space rays, whose directions are scaled by
+    // the instance's inverse transform: the same checks on rays that are not unit.
+    let soup = &scenes[0].1;
+    let rays: Vec<Ray> = random_rays(&mut rng, soup, bounds_of(soup), 6000)
+        .into_iter()
+        .enumerate()
+        .map(|(i, r)| Ray::new(r.o, r.d * [0.1, 3.0, 17.0][i % 3]))
+        .collect();
+    let hits = check_scene("soup, rays not unit", soup, &rays, &mut rng);
+    assert!(hits > 1000, "rays not unit: only {hits} hits");
 }
 
 #[test]

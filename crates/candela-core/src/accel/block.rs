@@ -1,16 +1,20 @@
-//! A leaf's primitives as one block of four lanes, coordinates side by side
-//! (structure of arrays), so that the watertight test runs on four triangles at once.
+//! A leaf's primitives as one block of eight lanes, coordinates side by side
+//! (structure of arrays), so that the watertight test runs on eight triangles at once:
+//! one AVX2 register where the CPU has it, two SSE halves otherwise (the second skipped
+//! when the block holds four or fewer, or when an any-hit query's first half hit).
 //!
-//! The four-lane test performs exactly the operations of [`WatertightRay::intersect`] in
+//! The vector test performs exactly the operations of [`WatertightRay::intersect`] in
 //! the same order (Rust never fuses a multiply and an add on its own), so each lane's
 //! distance and barycentrics are the same bits as the scalar test's. Lanes where an edge
 //! function is exactly zero take the scalar test, which retries those in double precision
 //! as the paper does. Blocks holding a sphere or a filtered triangle take the scalar path
 //! lane by lane, and so does everything under [`Simd::Scalar`], the reference the tests
-//! compare the four-lane path against.
+//! compare the vector paths against.
 
 use glam::Vec3;
 
+#[cfg(target_arch = "x86_64")]
+use super::lanes::Wide;
 #[cfg(doc)]
 use crate::bvh::Simd;
 use crate::geometry::{intersect_sphere, Ray, TriangleHit, WatertightRay};
@@ -19,15 +23,23 @@ pub const SPHERE: u32 = 1 << 31;
 pub const FILTERED: u32 = 1 << 30;
 pub const ID_MASK: u32 = FILTERED - 1;
 
-/// Up to four primitives. `v[vertex][axis][lane]`; a sphere lane holds its centre in
+/// Primitives a block holds: what the build's leaves are sized for.
+pub const LANES: usize = 8;
+
+/// Which test [`Block::intersect`] runs on blocks of plain triangles.
+pub const SCALAR: u8 = 0;
+pub const SSE: u8 = 1;
+pub const AVX2: u8 = 2;
+
+/// Up to eight primitives. `v[vertex][axis][lane]`; a sphere lane holds its centre in
 /// vertex 0 and its radius in vertex 1's x. `id[lane]` is the primitive index with the
-/// flag bits; unused lanes have NaN vertices, which no test hits, and id 0. 160 bytes,
-/// aligned so that each block spans three cache lines, not four.
+/// flag bits; unused lanes have NaN vertices, which no test hits, and id 0. 320 bytes,
+/// five cache lines (the ids in the last), each row of eight floats one aligned load.
 #[derive(Clone, Copy, Debug)]
-#[repr(C, align(32))]
+#[repr(C, align(64))]
 pub struct Block {
-    v: [[[f32; 4]; 3]; 3],
-    id: [u32; 4],
+    v: [[[f32; LANES]; 3]; 3],
+    id: [u32; LANES],
 }
 
 /// The nearest hit in a block: lane, and the triangle test's result.
@@ -36,13 +48,22 @@ pub struct LaneHit {
     pub hit: TriangleHit,
 }
 
+/// The vector test's per-lane results, written only for registers that hit something
+/// and read only in lanes that did.
+#[cfg(target_arch = "x86_64")]
+struct Lanes {
+    t: [f32; LANES],
+    b1: [f32; LANES],
+    b2: [f32; LANES],
+}
+
 impl Block {
-    /// Packs up to four primitives given as (vertices, id with flags).
+    /// Packs up to eight primitives given as (vertices, id with flags).
     pub fn new(prims: &[([Vec3; 3], u32)]) -> Block {
-        debug_assert!(prims.len() <= 4);
+        debug_assert!(prims.len() <= LANES);
         let mut b = Block {
-            v: [[[f32::NAN; 4]; 3]; 3],
-            id: [0; 4],
+            v: [[[f32::NAN; LANES]; 3]; 3],
+            id: [0; LANES],
         };
         for (lane, (v, id)) in prims.iter().enumerate() {
             for (vertex, p) in v.iter().enumerate() {
@@ -60,19 +81,31 @@ impl Block {
         Vec3::new(v[0][lane], v[1][lane], v[2][lane])
     }
 
-    /// Whether every lane is an unfiltered triangle (the four-lane path).
+    /// Whether every lane is an unfiltered triangle (the vector path).
     #[inline(always)]
-    fn plain(&self) -> bool {
-        (self.id[0] | self.id[1] | self.id[2] | self.id[3]) & (SPHERE | FILTERED) == 0
+    fn plain<const KERNEL: u8>(&self) -> bool {
+        #[cfg(target_arch = "x86_64")]
+        if KERNEL == AVX2 {
+            use std::arch::x86_64::*;
+            // SAFETY: the AVX2 kernel runs only on CPUs that have it. One `vptest`, not
+            // an OR of eight lanes (callgrind, instructions a ray on the Cornell box:
+            // closest-hit 660 -> 651, any-hit 415 -> 409).
+            return unsafe {
+                let ids = _mm256_loadu_si256(self.id.as_ptr() as *const __m256i);
+                _mm256_testz_si256(ids, _mm256_set1_epi32((SPHERE | FILTERED) as i32)) != 0
+            };
+        }
+        self.id.iter().fold(0, |a, &b| a | b) & (SPHERE | FILTERED) == 0
     }
 
     /// The nearest hit among the first `count` lanes within (0, t_max) that `filter`
     /// accepts (asked only for flagged triangles). Spheres report zero barycentrics.
-    /// `SIMD` chooses the four-lane test for plain blocks (x86-64 only). With `ANY`, the
-    /// first hit found is returned, not the nearest, and from the four-lane test without
-    /// barycentrics (a shadow ray needs only whether).
+    /// `KERNEL` chooses the vector test for plain blocks ([`SSE`], [`AVX2`]: x86-64
+    /// only, and the CPU must have it). With `ANY`, the first hit found is returned, not
+    /// the nearest, and from the vector test without barycentrics (a shadow ray needs
+    /// only whether).
     #[inline(always)]
-    pub fn intersect<const SIMD: bool, const ANY: bool>(
+    pub fn intersect<const KERNEL: u8, const ANY: bool>(
         &self,
         ray: &Ray,
         wray: &WatertightRay,
@@ -81,9 +114,9 @@ impl Block {
         filter: &impl Fn(u32, &TriangleHit) -> bool,
     ) -> Option<LaneHit> {
         #[cfg(target_arch = "x86_64")]
-        if SIMD && self.plain() {
-            // SAFETY: SSE is part of the x86-64 baseline.
-            return unsafe { self.intersect4_sse::<ANY>(wray, count, t_max) };
+        if KERNEL != SCALAR && self.plain::<KERNEL>() {
+            // SAFETY: SSE is part of the x86-64 baseline, and the caller vouches for AVX2.
+            return unsafe { self.intersect_lanes::<KERNEL, ANY>(wray, count, t_max) };
         }
         let mut best = None;
         let mut t_max = t_max;
@@ -116,157 +149,328 @@ impl Block {
         best
     }
 
-    /// [`WatertightRay::intersect`] on four lanes; the nearest hit, the lowest lane
-    /// among equals (as a sequential loop that narrows `t_max` would find).
+    /// The vector test of a plain block: the nearest hit, the lowest lane among equals
+    /// (as a sequential loop that narrows `t_max` would find).
+    ///
+    /// # Safety
+    /// The CPU must support `KERNEL`.
     #[cfg(target_arch = "x86_64")]
     #[inline(always)]
-    unsafe fn intersect4_sse<const ANY: bool>(
+    unsafe fn intersect_lanes<const KERNEL: u8, const ANY: bool>(
         &self,
         w: &WatertightRay,
         count: u32,
         t_max: f32,
     ) -> Option<LaneHit> {
-        use std::arch::x86_64::*;
+        use std::arch::x86_64::{__m128, __m256};
+        use std::mem::MaybeUninit;
+        let used = (1u32 << count) - 1;
+        let mut out = MaybeUninit::<Lanes>::uninit();
+        let out = out.as_mut_ptr();
+        let (hit, edge) = if KERNEL == AVX2 {
+            self.test_lanes::<__m256, ANY>(w, 0, used, t_max, out)
+        } else {
+            let (h0, e0) = self.test_lanes::<__m128, ANY>(w, 0, used & 15, t_max, out);
+            if count <= 4 || (ANY && h0 != 0) {
+                (h0, e0)
+            } else {
+                let (h1, e1) = self.test_lanes::<__m128, ANY>(w, 4, used >> 4, t_max, out);
+                (h0 | h1, e0 | e1)
+            }
+        };
+        if hit | edge == 0 {
+            return None;
+        }
+        // SAFETY: `test_lanes` wrote `t` (and without `ANY`, `b1` and `b2`) in every
+        // register that has a `hit` bit.
+        let lane_of = |row: *const [f32; LANES], lane: usize| unsafe { (*row)[lane] };
+        let t = |lane| lane_of(std::ptr::addr_of!((*out).t), lane);
+        if ANY && hit != 0 {
+            // Some lane is hit; a shadow ray needs no more (nor the barycentrics).
+            let lane = hit.trailing_zeros() as usize;
+            return Some(LaneHit {
+                id: self.id[lane] & ID_MASK,
+                hit: TriangleHit {
+                    t: t(lane),
+                    b1: 0.0,
+                    b2: 0.0,
+                },
+            });
+        }
+        let mut best = None;
+        let mut best_t = t_max;
+        let mut todo = hit | edge;
+        while todo != 0 {
+            let lane = todo.trailing_zeros() as usize;
+            todo &= todo - 1;
+            let found = if edge & (1 << lane) != 0 {
+                let [p0, p1, p2] = [0, 1, 2].map(|k| self.vertex(k, lane));
+                w.intersect(p0, p1, p2, best_t)
+            } else if t(lane) < best_t {
+                Some(TriangleHit {
+                    t: t(lane),
+                    b1: lane_of(std::ptr::addr_of!((*out).b1), lane),
+                    b2: lane_of(std::ptr::addr_of!((*out).b2), lane),
+                })
+            } else {
+                None
+            };
+            if let Some(h) = found {
+                best_t = h.t;
+                best = Some(LaneHit {
+                    id: self.id[lane] & ID_MASK,
+                    hit: h,
+                });
+                if ANY {
+                    break;
+                }
+            }
+        }
+        best
+    }
+
+    /// [`WatertightRay::intersect`] on the `V::LANES` lanes from `first` on (`used`: the
+    /// filled ones, bit 0 = lane `first`): which are hit without an exactly-zero edge
+    /// function, and which have one (for the scalar retry), as bits of the block's
+    /// lanes. Where some lane is either, the distances (and without `ANY` the
+    /// barycentrics) go to `out`.
+    ///
+    /// # Safety
+    /// The CPU must support `V`; `first + V::LANES <= LANES`.
+    #[cfg(target_arch = "x86_64")]
+    #[inline(always)]
+    unsafe fn test_lanes<V: Wide, const ANY: bool>(
+        &self,
+        w: &WatertightRay,
+        first: usize,
+        used: u32,
+        t_max: f32,
+        out: *mut Lanes,
+    ) -> (u32, u32) {
+        debug_assert!(first + V::LANES <= LANES);
         let (kx, ky, kz) = (w.kx, w.ky, w.kz);
-        let o = w.o.to_array();
-        let (ox, oy, oz) = (_mm_set1_ps(o[kx]), _mm_set1_ps(o[ky]), _mm_set1_ps(o[kz]));
+        let (ox, oy, oz) = (V::splat(w.o_k.x), V::splat(w.o_k.y), V::splat(w.o_k.z));
         let (sx, sy, sz) = (
-            _mm_set1_ps(w.shear.x),
-            _mm_set1_ps(w.shear.y),
-            _mm_set1_ps(w.shear.z),
+            V::splat(w.shear.x),
+            V::splat(w.shear.y),
+            V::splat(w.shear.z),
         );
-        // Vertex relative to the origin, sheared: (x, y) and the unscaled z. (A macro:
-        // closures here were left out of line, three calls a block.)
+        // Vertex relative to the origin, sheared: (x, y) and the unscaled z. (A macro,
+        // not a closure: a closure would not be compiled for AVX2, nor its loads inline.)
         macro_rules! rel {
             ($vertex:expr) => {{
-                let ld = |axis: usize| _mm_load_ps(self.v[$vertex][axis].as_ptr());
-                let z = _mm_sub_ps(ld(kz), oz);
-                let x = _mm_sub_ps(_mm_sub_ps(ld(kx), ox), _mm_mul_ps(sx, z));
-                let y = _mm_sub_ps(_mm_sub_ps(ld(ky), oy), _mm_mul_ps(sy, z));
+                // SAFETY: `WatertightRay::new` makes every axis index below 3.
+                let row = |axis: usize| self.v[$vertex].get_unchecked(axis).as_ptr().add(first);
+                let z = V::load(row(kz)).sub(oz);
+                let x = V::load(row(kx)).sub(ox).sub(sx.mul(z));
+                let y = V::load(row(ky)).sub(oy).sub(sy.mul(z));
                 (x, y, z)
             }};
         }
         let (ax, ay, a_z) = rel!(0);
         let (bx, by, b_z) = rel!(1);
         let (cx, cy, c_z) = rel!(2);
-        let u = _mm_sub_ps(_mm_mul_ps(cx, by), _mm_mul_ps(cy, bx));
-        let v = _mm_sub_ps(_mm_mul_ps(ax, cy), _mm_mul_ps(ay, cx));
-        let ww = _mm_sub_ps(_mm_mul_ps(bx, ay), _mm_mul_ps(by, ax));
-        let zero = _mm_setzero_ps();
-        let used = (1u32 << count) - 1;
-        let on_edge = _mm_or_ps(
-            _mm_or_ps(_mm_cmpeq_ps(u, zero), _mm_cmpeq_ps(v, zero)),
-            _mm_cmpeq_ps(ww, zero),
-        );
-        let on_edge = _mm_movemask_ps(on_edge) as u32 & used;
-        let any_neg = _mm_or_ps(
-            _mm_or_ps(_mm_cmplt_ps(u, zero), _mm_cmplt_ps(v, zero)),
-            _mm_cmplt_ps(ww, zero),
-        );
-        let any_pos = _mm_or_ps(
-            _mm_or_ps(_mm_cmpgt_ps(u, zero), _mm_cmpgt_ps(v, zero)),
-            _mm_cmpgt_ps(ww, zero),
-        );
-        let det = _mm_add_ps(_mm_add_ps(u, v), ww);
-        let t_scaled = _mm_add_ps(
-            _mm_add_ps(
-                _mm_mul_ps(u, _mm_mul_ps(sz, a_z)),
-                _mm_mul_ps(v, _mm_mul_ps(sz, b_z)),
-            ),
-            _mm_mul_ps(ww, _mm_mul_ps(sz, c_z)),
-        );
-        let t_max4 = _mm_set1_ps(t_max);
-        let limit = _mm_mul_ps(t_max4, det);
-        let bad_neg = _mm_and_ps(
-            _mm_cmplt_ps(det, zero),
-            _mm_or_ps(_mm_cmpge_ps(t_scaled, zero), _mm_cmplt_ps(t_scaled, limit)),
-        );
-        let bad_pos = _mm_and_ps(
-            _mm_cmpgt_ps(det, zero),
-            _mm_or_ps(_mm_cmple_ps(t_scaled, zero), _mm_cmpgt_ps(t_scaled, limit)),
-        );
-        let inv_det = _mm_div_ps(_mm_set1_ps(1.0), det);
-        let t = _mm_mul_ps(t_scaled, inv_det);
-        let rejected = _mm_or_ps(
-            _mm_or_ps(_mm_and_ps(any_neg, any_pos), _mm_cmpeq_ps(det, zero)),
-            _mm_or_ps(bad_neg, bad_pos),
-        );
-        let in_range = _mm_and_ps(_mm_cmpgt_ps(t, zero), _mm_cmplt_ps(t, t_max4));
-        let ok = _mm_andnot_ps(rejected, in_range);
-        let mask = _mm_movemask_ps(ok) as u32 & used & !on_edge;
-        if mask == 0 && on_edge == 0 {
-            return None;
+        let u = cx.mul(by).sub(cy.mul(bx));
+        let v = ax.mul(cy).sub(ay.mul(cx));
+        let ww = bx.mul(ay).sub(by.mul(ax));
+        let zero = V::splat(0.0);
+        // Unused lanes need no mask here: their NaN vertices give NaN edge functions and
+        // distances, which are neither zero nor in range.
+        let on_edge = u.eq(zero).or(v.eq(zero)).or(ww.eq(zero)).bits();
+        // Some edge function negative and some positive: the scalar test's six
+        // comparisons as the sign of the least and the greatest. (They differ only where
+        // one is NaN, and there `det` and `t` are NaN too, which no lane passes.)
+        let mixed_signs = u.min(v).min(ww).lt(zero).and(u.max(v).max(ww).gt(zero));
+        let det = u.add(v).add(ww);
+        let t_scaled = u
+            .mul(sz.mul(a_z))
+            .add(v.mul(sz.mul(b_z)))
+            .add(ww.mul(sz.mul(c_z)));
+        let t_max_v = V::splat(t_max);
+        let limit = t_max_v.mul(det);
+        let bad_neg = det.lt(zero).and(t_scaled.ge(zero).or(t_scaled.lt(limit)));
+        let bad_pos = det.gt(zero).and(t_scaled.le(zero).or(t_scaled.gt(limit)));
+        let rejected = mixed_signs.or(det.eq(zero)).or(bad_neg.or(bad_pos));
+        if !ANY && !rejected.bits() & used | on_edge == 0 {
+            // Every lane is rejected before the division, as in the scalar test (for a
+            // shadow ray, whose blocks are hit more often, the check costs more than it
+            // saves: callgrind, any-hit instructions per ray on the room 468 -> 480).
+            return (0, 0);
         }
-        let mut ts = [0.0f32; 4];
-        _mm_storeu_ps(ts.as_mut_ptr(), t);
-        if ANY && mask != 0 {
-            // Some lane is hit; a shadow ray needs no more (nor the barycentrics).
-            let lane = mask.trailing_zeros() as usize;
-            return Some(LaneHit {
-                id: self.id[lane] & ID_MASK,
-                hit: TriangleHit {
-                    t: ts[lane],
-                    b1: 0.0,
-                    b2: 0.0,
-                },
-            });
+        let inv_det = V::splat(1.0).div(det);
+        let t = t_scaled.mul(inv_det);
+        let in_range = t.gt(zero).and(t.lt(t_max_v));
+        let hit = rejected.andnot(in_range).bits() & !on_edge;
+        if hit | on_edge == 0 {
+            return (0, 0);
         }
-        if on_edge == 0 {
-            // The nearest lane without a loop: the minimum of the hit lanes' distances
-            // (misses at +∞), then the lowest lane that has it.
-            let tm = _mm_or_ps(
-                _mm_and_ps(ok, t),
-                _mm_andnot_ps(ok, _mm_set1_ps(f32::INFINITY)),
-            );
-            let m = _mm_min_ps(tm, _mm_shuffle_ps::<0b10_11_00_01>(tm, tm));
-            let m = _mm_min_ps(m, _mm_shuffle_ps::<0b01_00_11_10>(m, m));
-            let lane = (_mm_movemask_ps(_mm_cmpeq_ps(tm, m)) as u32 & mask).trailing_zeros();
-            let lane = lane as usize;
-            let mut vs = [0.0f32; 4];
-            let mut ws = [0.0f32; 4];
-            _mm_storeu_ps(vs.as_mut_ptr(), _mm_mul_ps(v, inv_det));
-            _mm_storeu_ps(ws.as_mut_ptr(), _mm_mul_ps(ww, inv_det));
-            return Some(LaneHit {
-                id: self.id[lane] & ID_MASK,
-                hit: TriangleHit {
-                    t: ts[lane],
-                    b1: vs[lane],
-                    b2: ws[lane],
-                },
-            });
+        let row = |r: *mut [f32; LANES]| (r as *mut f32).add(first);
+        t.store(row(std::ptr::addr_of_mut!((*out).t)));
+        if !ANY {
+            v.mul(inv_det).store(row(std::ptr::addr_of_mut!((*out).b1)));
+            ww.mul(inv_det)
+                .store(row(std::ptr::addr_of_mut!((*out).b2)));
         }
-        let mut best: Option<(usize, TriangleHit)> = None;
-        let mut best_t = t_max;
-        for (lane, &t_lane) in ts.iter().enumerate().take(count as usize) {
-            let hit = if on_edge & (1 << lane) != 0 {
-                let [p0, p1, p2] = [0, 1, 2].map(|k| self.vertex(k, lane));
-                w.intersect(p0, p1, p2, best_t)
-            } else if mask & (1 << lane) != 0 && t_lane < best_t {
-                Some(TriangleHit {
-                    t: t_lane,
-                    b1: 0.0,
-                    b2: 0.0,
-                })
-            } else {
-                None
+        (hit << first, on_edge << first)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::bvh::Simd;
+    use crate::sampler::Pcg32;
+
+    fn v3(rng: &mut Pcg32) -> Vec3 {
+        Vec3::new(rng.uniform_f32(), rng.uniform_f32(), rng.uniform_f32())
+    }
+
+    /// `Block::intersect` with the kernel `simd` names (which the CPU must have).
+    fn trace<const ANY: bool>(
+        simd: Simd,
+        block: &Block,
+        ray: &Ray,
+        count: u32,
+        t_max: f32,
+        filter: &impl Fn(u32, &TriangleHit) -> bool,
+    ) -> Option<(u32, [u32; 3])> {
+        #[cfg(target_arch = "x86_64")]
+        #[target_feature(enable = "avx2")]
+        unsafe fn avx2<const ANY: bool>(
+            block: &Block,
+            ray: &Ray,
+            count: u32,
+            t_max: f32,
+            filter: &impl Fn(u32, &TriangleHit) -> bool,
+        ) -> Option<LaneHit> {
+            block.intersect::<AVX2, ANY>(ray, &WatertightRay::new(ray), count, t_max, filter)
+        }
+        let w = WatertightRay::new(ray);
+        let hit = match simd {
+            Simd::Scalar => block.intersect::<SCALAR, ANY>(ray, &w, count, t_max, filter),
+            Simd::Sse => block.intersect::<SSE, ANY>(ray, &w, count, t_max, filter),
+            // SAFETY: the caller passes only kernels from `Simd::available`.
+            #[cfg(target_arch = "x86_64")]
+            Simd::Avx2 => unsafe { avx2::<ANY>(block, ray, count, t_max, filter) },
+            #[cfg(not(target_arch = "x86_64"))]
+            Simd::Avx2 => unreachable!(),
+        };
+        hit.map(|h| (h.id, [h.hit.t, h.hit.b1, h.hit.b2].map(f32::to_bits)))
+    }
+
+    /// Every fill from one lane to eight, plain blocks and blocks mixing spheres and
+    /// filtered triangles in: each kernel the CPU has returns the scalar kernel's lane,
+    /// distance and barycentrics bit for bit, and that is the nearest hit of a plain loop
+    /// over `WatertightRay::intersect` (the lowest lane among equal distances). Rays aim
+    /// at points inside the triangles, at their vertices (exactly zero edge functions:
+    /// the double-precision retry) and along the axes.
+    #[test]
+    fn every_kernel_gives_the_scalar_bits_at_every_fill() {
+        let mut rng = Pcg32::new(8, 8);
+        let simds = Simd::available();
+        let (mut hits, mut vertex_hits, mut mixed) = (0, 0, 0);
+        let accept_even = |id: u32, _: &TriangleHit| id.is_multiple_of(2);
+        for trial in 0..40000u32 {
+            let count = 1 + trial % 8;
+            let kind = |lane: u32| (trial / 8 + lane) % 11;
+            let mut prims = Vec::new();
+            // Vertices on a coarse grid half the time, so triangles share edges.
+            let grid = |v: Vec3| {
+                if trial % 2 == 0 {
+                    (v * 4.0).floor() / 4.0
+                } else {
+                    v
+                }
             };
-            if let Some(h) = hit {
-                best_t = h.t;
-                best = Some((lane, h));
+            for lane in 0..count {
+                let v = [0; 3].map(|_| grid(v3(&mut rng)));
+                let flags = match kind(lane) {
+                    0 if trial % 3 == 0 => SPHERE,
+                    1 if trial % 3 == 0 => FILTERED,
+                    _ => 0,
+                };
+                let v = if flags == SPHERE {
+                    [
+                        v[0],
+                        Vec3::new(0.1 + 0.2 * rng.uniform_f32(), 0.0, 0.0),
+                        Vec3::ZERO,
+                    ]
+                } else {
+                    v
+                };
+                prims.push((v, lane | flags));
             }
+            mixed += prims.iter().any(|p| p.1 & (SPHERE | FILTERED) != 0) as u32;
+            let block = Block::new(&prims);
+            let target = prims[rng.next_u32() as usize % count as usize].0;
+            let o = v3(&mut rng) * 3.0 - 1.0;
+            let at_vertex = trial % 4 == 0 && prims.iter().all(|p| p.1 & SPHERE == 0);
+            let aim = if at_vertex {
+                target[trial as usize / 4 % 3]
+            } else {
+                let (a, b) = (rng.uniform_f32(), rng.uniform_f32());
+                let (a, b) = if a + b > 1.0 {
+                    (1.0 - a, 1.0 - b)
+                } else {
+                    (a, b)
+                };
+                target[0] + (target[1] - target[0]) * a + (target[2] - target[0]) * b
+            };
+            let mut d = aim - o;
+            if trial % 7 == 0 {
+                d.x = 0.0;
+            }
+            let ray = Ray::new(o, d.normalize_or(Vec3::Y));
+            let t_max = if trial % 5 == 0 {
+                2.0 * rng.uniform_f32()
+            } else {
+                f32::INFINITY
+            };
+
+            let mut reference = None;
+            let mut best = t_max;
+            for (lane, (v, id)) in prims.iter().enumerate() {
+                let hit = if id & SPHERE != 0 {
+                    intersect_sphere(&ray, v[0], v[1].x, best).map(|t| TriangleHit {
+                        t,
+                        b1: 0.0,
+                        b2: 0.0,
+                    })
+                } else {
+                    WatertightRay::new(&ray)
+                        .intersect(v[0], v[1], v[2], best)
+                        .filter(|h| id & FILTERED == 0 || accept_even(lane as u32, h))
+                };
+                if let Some(h) = hit {
+                    best = h.t;
+                    reference = Some((lane as u32, [h.t, h.b1, h.b2].map(f32::to_bits)));
+                }
+            }
+            let scalar = trace::<false>(Simd::Scalar, &block, &ray, count, t_max, &accept_even);
+            assert_eq!(
+                scalar, reference,
+                "trial {trial}: scalar kernel vs a plain loop"
+            );
+            for &simd in &simds {
+                let nearest = trace::<false>(simd, &block, &ray, count, t_max, &accept_even);
+                assert_eq!(nearest, scalar, "trial {trial}: {simd:?}, {count} lanes");
+                let any = trace::<true>(simd, &block, &ray, count, t_max, &accept_even);
+                assert_eq!(
+                    any.is_some(),
+                    scalar.is_some(),
+                    "trial {trial}: {simd:?} any-hit"
+                );
+            }
+            hits += scalar.is_some() as u32;
+            vertex_hits += (at_vertex && scalar.is_some()) as u32;
         }
-        let (lane, mut hit) = best?;
-        if on_edge & (1 << lane) == 0 {
-            let mut vs = [0.0f32; 4];
-            let mut ws = [0.0f32; 4];
-            _mm_storeu_ps(vs.as_mut_ptr(), _mm_mul_ps(v, inv_det));
-            _mm_storeu_ps(ws.as_mut_ptr(), _mm_mul_ps(ww, inv_det));
-            hit.b1 = vs[lane];
-            hit.b2 = ws[lane];
-        }
-        Some(LaneHit {
-            id: self.id[lane] & ID_MASK,
-            hit,
-        })
+        // Thresholds: about half the rays aim inside a triangle and meet it unless
+        // something nearer or `t_max` intervenes; a quarter aim at vertices.
+        assert!(hits > 15000, "only {hits} hits");
+        assert!(vertex_hits > 2000, "only {vertex_hits} hits at vertices");
+        assert!(mixed > 3000, "only {mixed} mixed blocks");
+        eprintln!(
+            "kernels {simds:?}: {hits} hits, {vertex_hits} at vertices, {mixed} mixed blocks"
+        );
     }
 }

@@ -1,7 +1,8 @@
 //! The ray-tracing acceleration structure: a [`WideBvh`] (eight children a node) over the
-//! scene's primitives, each leaf's primitives copied into one [`block::Block`] of four
-//! lanes with the vertices inline (no index → mesh → position chase), tested four at a
-//! time.
+//! scene's primitives, each leaf's primitives copied into one [`block::Block`] of eight
+//! lanes with the vertices inline (no index → mesh → position chase), tested eight at a
+//! time. The build sizes leaves knowing that a leaf of up to eight triangles costs one
+//! block test ([`SahCost::BLOCKS`]).
 //!
 //! Triangles keep the watertight test (Woop et al. 2013) on the same vertex values as
 //! the meshes, so a hit's distance is the same bits as the mesh's own test gives. Each
@@ -10,21 +11,25 @@
 //! it after its barycentrics are known, and traversal goes on past it when the filter
 //! rejects.
 //!
-//! The SIMD kernels ([`Simd`]) are chosen once, at build: AVX2 box tests where the CPU
-//! has them, else SSE; [`Accel::build_for`] forces one (the tests run each the CPU has
+//! The SIMD kernels ([`Simd`]) are chosen once, at build: AVX2 box and triangle tests
+//! where the CPU has them, else SSE; [`Accel::build_for`] forces one (the tests run each the CPU has
 //! against the scalar one). Every kernel finds the same hits, bit for bit.
 
 mod block;
+mod lanes;
 
 use glam::Vec3;
 
 #[cfg(target_arch = "x86_64")]
 use crate::bvh::{Avx2Boxes, SseBoxes};
-use crate::bvh::{BoxTest, Bvh, ScalarBoxes, WideBvh};
+use crate::bvh::{BoxTest, Bvh, SahCost, ScalarBoxes, WideBvh};
 use crate::geometry::{Aabb, Ray, TriangleHit, WatertightRay};
-use block::{Block, FILTERED, ID_MASK, SPHERE};
+use block::{Block, FILTERED, ID_MASK, LANES, SPHERE};
 
 pub use crate::bvh::Simd;
+
+// Every leaf of the build fits one block.
+const _: () = assert!(SahCost::BLOCKS.max_leaf == LANES);
 
 /// A primitive handed to [`Accel::build`].
 #[derive(Clone, Copy, Debug)]
@@ -86,7 +91,7 @@ impl Accel {
             "at most 2^30 primitives per scene"
         );
         let boxes: Vec<Aabb> = shapes.iter().map(Shape::bounds).collect();
-        let binary = Bvh::build(&boxes);
+        let binary = Bvh::build_with(&boxes, SahCost::BLOCKS);
         let record = |i: u32| match shapes[i as usize] {
             Shape::Triangle(v) => (v, i | if filtered(i) { FILTERED } else { 0 }),
             Shape::Sphere { center, radius } => (
@@ -140,8 +145,8 @@ impl Accel {
                 #[cfg(target_arch = "x86_64")]
                 Simd::Avx2 => self.intersect_avx2(ray, t_max, &filter),
                 #[cfg(target_arch = "x86_64")]
-                Simd::Sse => self.intersect_with::<SseBoxes, true>(ray, t_max, &filter),
-                _ => self.intersect_with::<ScalarBoxes, false>(ray, t_max, &filter),
+                Simd::Sse => self.intersect_with::<SseBoxes, { block::SSE }>(ray, t_max, &filter),
+                _ => self.intersect_with::<ScalarBoxes, { block::SCALAR }>(ray, t_max, &filter),
             }
         }
     }
@@ -161,13 +166,14 @@ impl Accel {
                 #[cfg(target_arch = "x86_64")]
                 Simd::Avx2 => self.occluded_avx2(ray, t_max, &filter),
                 #[cfg(target_arch = "x86_64")]
-                Simd::Sse => self.occluded_with::<SseBoxes, true>(ray, t_max, &filter),
-                _ => self.occluded_with::<ScalarBoxes, false>(ray, t_max, &filter),
+                Simd::Sse => self.occluded_with::<SseBoxes, { block::SSE }>(ray, t_max, &filter),
+                _ => self.occluded_with::<ScalarBoxes, { block::SCALAR }>(ray, t_max, &filter),
             }
         }
     }
 
-    /// The traversal compiled with AVX2 enabled, so that its box kernel inlines.
+    /// The traversal compiled with AVX2 enabled, so that its box and triangle kernels
+    /// inline.
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2")]
     unsafe fn intersect_avx2<F: Fn(u32, &TriangleHit) -> bool>(
@@ -176,7 +182,7 @@ impl Accel {
         t_max: f32,
         filter: &F,
     ) -> Option<Hit> {
-        self.intersect_with::<Avx2Boxes, true>(ray, t_max, filter)
+        self.intersect_with::<Avx2Boxes, { block::AVX2 }>(ray, t_max, filter)
     }
 
     #[cfg(target_arch = "x86_64")]
@@ -187,13 +193,13 @@ impl Accel {
         t_max: f32,
         filter: &F,
     ) -> bool {
-        self.occluded_with::<Avx2Boxes, true>(ray, t_max, filter)
+        self.occluded_with::<Avx2Boxes, { block::AVX2 }>(ray, t_max, filter)
     }
 
     /// # Safety
-    /// The CPU must support `K`.
+    /// The CPU must support `K` and `LEAF`.
     #[inline(always)]
-    unsafe fn intersect_with<K: BoxTest, const SIMD: bool>(
+    unsafe fn intersect_with<K: BoxTest, const LEAF: u8>(
         &self,
         ray: &Ray,
         t_max: f32,
@@ -207,7 +213,7 @@ impl Accel {
             #[inline(always)]
             |block, count, t_max| {
                 let block = &self.blocks[block as usize];
-                match block.intersect::<SIMD, false>(ray, &wray, count, t_max, filter) {
+                match block.intersect::<LEAF, false>(ray, &wray, count, t_max, filter) {
                     Some(h) => {
                         best = Some(Hit {
                             prim: h.id,
@@ -223,16 +229,16 @@ impl Accel {
             #[inline(always)]
             |block| {
                 let at = self.blocks.as_ptr().wrapping_add(block as usize);
-                crate::bvh::prefetch(at as *const u8, 3)
+                crate::bvh::prefetch(at as *const u8, size_of::<Block>() / 64)
             },
         );
         best
     }
 
     /// # Safety
-    /// The CPU must support `K`.
+    /// The CPU must support `K` and `LEAF`.
     #[inline(always)]
-    unsafe fn occluded_with<K: BoxTest, const SIMD: bool>(
+    unsafe fn occluded_with<K: BoxTest, const LEAF: u8>(
         &self,
         ray: &Ray,
         t_max: f32,
@@ -245,7 +251,7 @@ impl Accel {
             #[inline(always)]
             |block, count, t_max| {
                 self.blocks[block as usize]
-                    .intersect::<SIMD, true>(ray, &wray, count, t_max, filter)
+                    .intersect::<LEAF, true>(ray, &wray, count, t_max, filter)
                     .is_some()
             },
         )

@@ -11,7 +11,6 @@ use super::box8::T_MAX_SCALE;
 use crate::geometry::{Aabb, Ray};
 
 const BINS: usize = 16;
-const MAX_LEAF: usize = 4;
 /// Subtrees larger than this are built in parallel.
 const PARALLEL_THRESHOLD: usize = 4096;
 /// From this depth on, splits fall back to the median, so that no tree is deeper than
@@ -32,6 +31,39 @@ impl BvhNode {
     pub fn is_leaf(&self) -> bool {
         self.count > 0
     }
+}
+
+/// How the SAH sizes leaves. Nodes of more than `max_leaf` primitives are always split,
+/// by the usual cost (primitives × box area on each side). A smaller node is tested as
+/// one block whatever its count (the accelerator's [`crate::accel`] blocks hold up to
+/// `max_leaf`), so it is split only where two blocks, each weighted by its box area, and
+/// `node` more (a binary node, in block tests) cost less than one.
+#[derive(Clone, Copy, Debug)]
+pub struct SahCost {
+    pub max_leaf: usize,
+    /// From 1 on (two children cost at least as much as one block) no split of a small
+    /// node pays, and their SAH sweep is skipped.
+    pub node: f32,
+}
+
+impl SahCost {
+    /// Leaves of up to four, never split: the binary tree's own traversal (its tests,
+    /// and the instance TLAS, whose leaves are instances).
+    pub const PRIMS: SahCost = SahCost {
+        max_leaf: 4,
+        node: 1.0,
+    };
+
+    /// Eight-lane blocks (the scene's [`crate::accel::Accel`]). A node costs nothing
+    /// here: the collapse to eight-wide nodes absorbs binary nodes. Measured with the
+    /// first eight-lane kernel (callgrind instructions per closest-hit ray,
+    /// bench/traversal.sh's rays): a node cost of 0
+    /// gave 674 on the Cornell box, 0.5 gave 781, the 590k room 1606 and 1598; pricing
+    /// large nodes by blocks (⌈n / 8⌉ × area) instead of primitives gave 756 at 0.
+    pub const BLOCKS: SahCost = SahCost {
+        max_leaf: 8,
+        node: 0.0,
+    };
 }
 
 #[derive(Clone, Debug, Default)]
@@ -65,9 +97,15 @@ impl BuildNode {
 }
 
 impl Bvh {
-    /// Builds a BVH over primitives with the given boxes. Primitives with empty or
-    /// non-finite boxes are left out: no ray can hit them.
+    /// Builds a BVH over primitives with the given boxes, leaves sized for
+    /// [`SahCost::PRIMS`]. Primitives with empty or non-finite boxes are left out: no ray
+    /// can hit them.
     pub fn build(boxes: &[Aabb]) -> Bvh {
+        Bvh::build_with(boxes, SahCost::PRIMS)
+    }
+
+    /// [`Bvh::build`] with the given cost model.
+    pub fn build_with(boxes: &[Aabb], cost: SahCost) -> Bvh {
         let mut infos: Vec<PrimInfo> = boxes
             .iter()
             .enumerate()
@@ -82,7 +120,7 @@ impl Bvh {
             return Bvh::default();
         }
         let extents = Extents::of(&infos);
-        let root = build_recursive(&mut infos, 0, 0, extents);
+        let root = build_recursive(&mut infos, 0, 0, extents, &cost);
         let mut bvh = Bvh {
             nodes: Vec::with_capacity(root.node_count()),
             prims: infos.iter().map(|p| p.index).collect(),
@@ -226,7 +264,13 @@ impl Bvh {
     }
 }
 
-fn build_recursive(prims: &mut [PrimInfo], first: usize, depth: usize, ext: Extents) -> BuildNode {
+fn build_recursive(
+    prims: &mut [PrimInfo],
+    first: usize,
+    depth: usize,
+    ext: Extents,
+    cost: &SahCost,
+) -> BuildNode {
     let bounds = ext.bounds.aabb();
     let n = prims.len();
     let leaf = BuildNode::Leaf {
@@ -234,10 +278,12 @@ fn build_recursive(prims: &mut [PrimInfo], first: usize, depth: usize, ext: Exte
         first,
         count: n,
     };
-    // Up to four primitives always make a leaf: the accelerator tests a leaf as one
-    // four-lane block, which costs about what one more node would, so splitting it
-    // further never pays (measured: 15–20 % more closest-hit rays/s on the 590k room).
-    if n <= MAX_LEAF {
+    // A split of a one-block leaf saves at most one block test and costs a node: with
+    // `cost.node` ≥ 1 it never pays (with four-lane blocks, always making leaves of four
+    // measured 15–20 % more closest-hit rays/s on the 590k room than splitting down to
+    // single triangles).
+    let small = n <= cost.max_leaf;
+    if small && (n == 1 || cost.node >= 1.0) {
         return leaf;
     }
     let cmin = ext.centroids.min;
@@ -245,7 +291,10 @@ fn build_recursive(prims: &mut [PrimInfo], first: usize, depth: usize, ext: Exte
     let axis = extent.max_position();
     if extent[axis] <= 0.0 || depth >= MAX_SAH_DEPTH {
         // All centroids coincide (no split separates them), or the tree is deep enough.
-        return split_middle(prims, first, bounds, axis, depth);
+        if small {
+            return leaf;
+        }
+        return split_middle(prims, first, bounds, axis, depth, cost);
     }
 
     // Bin centroids along the widest axis and sweep for the cheapest SAH split.
@@ -287,14 +336,22 @@ fn build_recursive(prims: &mut [PrimInfo], first: usize, depth: usize, ext: Exte
         if count == 0 || right_count[i + 1] == 0 {
             continue;
         }
-        let cost = count as f32 * area(&acc) + right_count[i + 1] as f32 * right_area[i + 1];
-        if cost < best_cost {
-            best_cost = cost;
+        let split = if small {
+            area(&acc) + right_area[i + 1]
+        } else {
+            count as f32 * area(&acc) + right_count[i + 1] as f32 * right_area[i + 1]
+        };
+        if split < best_cost {
+            best_cost = split;
             best_split = i;
         }
     }
+    if small && best_cost + cost.node * area(&ext.bounds) >= area(&ext.bounds) {
+        // One block costs no more than the node and the children's blocks.
+        return leaf;
+    }
     if !best_cost.is_finite() {
-        return split_middle(prims, first, bounds, axis, depth);
+        return split_middle(prims, first, bounds, axis, depth, cost);
     }
     let mid = partition(prims, |p| bin_of(p) <= best_split);
     let (mut left, mut right) = (bins[0], bins[best_split + 1]);
@@ -304,7 +361,16 @@ fn build_recursive(prims: &mut [PrimInfo], first: usize, depth: usize, ext: Exte
     for b in &bins[best_split + 2..nb] {
         right.merge(b);
     }
-    make_interior(prims, first, bounds, axis, mid, depth, Some((left, right)))
+    make_interior(
+        prims,
+        first,
+        bounds,
+        axis,
+        mid,
+        depth,
+        Some((left, right)),
+        cost,
+    )
 }
 
 fn split_middle(
@@ -313,12 +379,13 @@ fn split_middle(
     bounds: Aabb,
     axis: usize,
     depth: usize,
+    cost: &SahCost,
 ) -> BuildNode {
     let mid = prims.len() / 2;
     prims.select_nth_unstable_by(mid, |a, b| {
         a.centroid2()[axis].total_cmp(&b.centroid2()[axis])
     });
-    make_interior(prims, first, bounds, axis, mid, depth, None)
+    make_interior(prims, first, bounds, axis, mid, depth, None, cost)
 }
 
 /// Builds the two halves `..mid` and `mid..` (in parallel when large), with their
@@ -332,19 +399,20 @@ fn make_interior(
     mid: usize,
     depth: usize,
     extents: Option<(Extents, Extents)>,
+    cost: &SahCost,
 ) -> BuildNode {
     let n = prims.len();
     let (left, right) = prims.split_at_mut(mid);
     let (el, er) = extents.unwrap_or_else(|| (Extents::of(left), Extents::of(right)));
     let (a, b) = if n > PARALLEL_THRESHOLD {
         rayon::join(
-            || build_recursive(left, first, depth + 1, el),
-            || build_recursive(right, first + mid, depth + 1, er),
+            || build_recursive(left, first, depth + 1, el, cost),
+            || build_recursive(right, first + mid, depth + 1, er, cost),
         )
     } else {
         (
-            build_recursive(left, first, depth + 1, el),
-            build_recursive(right, first + mid, depth + 1, er),
+            build_recursive(left, first, depth + 1, el, cost),
+            build_recursive(right, first + mid, depth + 1, er, cost),
         )
     };
     let size = 1 + a.node_count() + b.node_count();

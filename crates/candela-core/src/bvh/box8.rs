@@ -57,9 +57,9 @@ pub enum Simd {
     /// Plain Rust, lane by lane (the default: it runs everywhere).
     #[default]
     Scalar,
-    /// 4-lane SSE (x86-64 baseline).
+    /// 4-lane SSE (x86-64 baseline): eight boxes or triangles as two halves.
     Sse,
-    /// 8-lane AVX2 box tests, 4-lane triangle tests in VEX encoding.
+    /// 8-lane AVX2 box and triangle tests.
     Avx2,
 }
 

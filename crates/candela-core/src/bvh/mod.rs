@@ -16,7 +16,7 @@ mod box8;
 mod extents;
 mod wide;
 
-pub use binary::{Bvh, BvhNode};
+pub use binary::{Bvh, BvhNode, SahCost};
 pub use box8::{hit8_scalar, BoxTest, Planes8, Ray8, ScalarBoxes, Simd, T_MAX_SCALE};
 #[cfg(target_arch = "x86_64")]
 pub use box8::{Avx2Boxes, SseBoxes};
