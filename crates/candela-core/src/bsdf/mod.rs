@@ -230,8 +230,8 @@ impl Bsdf {
 
     /// Whether the geometric normal agrees with the shading frame on reflection versus
     /// transmission for this pair (see the module's conventions on light leaks).
-    #[inline(always)]
     /// `cos_o` and `cos_i` are the local z of `wo` and `wi` (their shading cosines).
+    #[inline(always)]
     fn sides_agree(&self, wo: Vec3, wi: Vec3, cos_o: f32, cos_i: f32) -> bool {
         let geometric_reflection = wo.dot(self.ng) * wi.dot(self.ng) > 0.0;
         let shading_reflection = cos_o * cos_i > 0.0;
