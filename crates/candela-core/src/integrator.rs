@@ -21,12 +21,13 @@ use crate::scene::{Scene, SurfaceInteraction};
 
 /// Rows per parallel work item.
 const BAND_ROWS: usize = 4;
-/// Russian roulette starts after this many bounces, as Mitsuba's default `rr_depth`.
-/// Measured on the 512² Cornell box at 64 spp, two seeds each: from 3 bounces to 5,
-/// relMSE (net of the reference's noise) fell from 0.00215 to 0.00143 for 4.64 → 5.94 rays
-/// a path and 8.46 → 10.85 s, 18 % more efficient per ray and 17 % per second; 4 and 6
-/// gave 112 and 122 per ray against 118 here, and no roulette before depth 8 gave 111.
-const RR_MIN_DEPTH: u32 = 5;
+/// Russian roulette starts after this many bounces. Mitsuba's default (5) is 18 % more
+/// efficient on the 512² Cornell box at 64 spp (net relMSE 0.00215 → 0.00143 for 4.64 →
+/// 5.94 rays a path, stop 16), but by then a dark scene's throughput is small, so the rare
+/// survivors carry large weights: in the closed ρ = 0.5 sphere of `tests/analytic.rs` a
+/// pixel landed 7σ out. A roulette that compares the throughput with the pixel's expected
+/// value would keep both.
+const RR_MIN_DEPTH: u32 = 3;
 
 /// Counters of one render.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]

@@ -49,7 +49,7 @@ pub(crate) fn integrator(ctx: &mut Ctx, node: &Node) -> Result<(), LoadError> {
             let p = node.prop("rr_depth").expect("read just now");
             ctx.warn(
                 p,
-                "rr_depth is ignored: Candela's Russian roulette starts after 5 bounces (Mitsuba's default)",
+                "rr_depth is ignored: Candela's Russian roulette starts after 3 bounces",
             );
         }
     }
