@@ -89,6 +89,9 @@ pub struct RenderArgs {
     /// Maximum scattering events per path (0: emitters only, 1: direct light).
     #[arg(long)]
     max_depth: Option<u32>,
+    /// Scattering events before Russian roulette may end a path (default 5, as Mitsuba).
+    #[arg(long)]
+    rr_depth: Option<u32>,
     /// Resolution as WIDTHxHEIGHT.
     #[arg(long, value_parser = parse_resolution)]
     res: Option<(u32, u32)>,
@@ -164,6 +167,7 @@ impl RenderArgs {
         if let Some(d) = self.max_depth {
             r.max_depth = d;
         }
+        r.rr_depth = self.rr_depth.unwrap_or(r.rr_depth);
         if let Some((w, h)) = self.res {
             (r.width, r.height) = (w, h);
         }

@@ -570,6 +570,10 @@ pub enum SamplerKind {
 /// Default number of RIS candidates, chosen by `bench/many_lights`.
 pub const DEFAULT_RIS_CANDIDATES: u32 = 2;
 
+/// Default of [`RenderSettings::rr_depth`]: Mitsuba's, and the most efficient start of
+/// the roulette measured on Candela's example scenes (bench/RESULTS.md, stop 17).
+pub const DEFAULT_RR_DEPTH: u32 = 5;
+
 /// Render settings a scene carries; the command line may override them.
 #[derive(Clone, Debug)]
 pub struct RenderSettings {
@@ -579,6 +583,9 @@ pub struct RenderSettings {
     /// Maximum number of scattering events along a path: 0 shows emitters only, 1 gives
     /// direct light, and so on.
     pub max_depth: u32,
+    /// Russian roulette may end a path once it has scattered this many times (Mitsuba's
+    /// `rr_depth`, counted the same way; its default, 5). Before that every path goes on.
+    pub rr_depth: u32,
     pub seed: u64,
     pub mis: MisMode,
     pub light_sampler: LightSamplerKind,
@@ -614,6 +621,7 @@ impl Default for RenderSettings {
             height: 512,
             spp: 64,
             max_depth: 8,
+            rr_depth: DEFAULT_RR_DEPTH,
             seed: 0,
             mis: MisMode::default(),
             light_sampler: LightSamplerKind::default(),

@@ -21,13 +21,6 @@ use crate::scene::{Scene, SurfaceInteraction};
 
 /// Rows per parallel work item.
 const BAND_ROWS: usize = 4;
-/// Russian roulette starts after this many bounces. Mitsuba's default (5) is 18 % more
-/// efficient on the 512² Cornell box at 64 spp (net relMSE 0.00215 → 0.00143 for 4.64 →
-/// 5.94 rays a path, stop 16), but by then a dark scene's throughput is small, so the rare
-/// survivors carry large weights: in the closed ρ = 0.5 sphere of `tests/analytic.rs` a
-/// pixel landed 7σ out. A roulette that compares the throughput with the pixel's expected
-/// value would keep both.
-const RR_MIN_DEPTH: u32 = 3;
 
 /// Counters of one render.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -170,6 +163,8 @@ pub fn li<S: Sampler>(scene: &Scene, mut ray: Ray, sampler: &mut S, rays: &mut u
     let mode = scene.settings.mis;
     let mut l = Vec3::ZERO;
     let mut beta = Vec3::ONE;
+    // The product of η′² over the refractions so far (see `Bsdf::eta_crossed_sq`).
+    let mut eta_scale = 1.0f32;
     let mut depth = 0u32;
     // Whether the path's last bounce was a delta lobe (or the path just left the camera):
     // then no light sampling could have found what the ray hits, so it counts in full.
@@ -263,14 +258,15 @@ pub fn li<S: Sampler>(scene: &Scene, mut ray: Ray, sampler: &mut S, rays: &mut u
         ray = si.spawn_ray(bs.wi);
         depth += 1;
 
-        if depth < RR_MIN_DEPTH {
+        eta_scale *= bsdf.eta_crossed_sq(wo, &bs);
+        if depth < scene.settings.rr_depth {
             sampler.skip_1d();
         } else {
             let u_rr = sampler.get_1d();
             // Survival in proportion to the throughput, so survivors carry weight ~1.
             // No cap below 1 (Mitsuba caps at 0.95): in a white furnace a cap makes the
             // weights grow by 1/0.95 per bounce and the variance unbounded.
-            let q = (1.0 - max_component(beta)).max(0.0);
+            let q = (1.0 - max_component(beta) * eta_scale).max(0.0);
             if u_rr < q {
                 break;
             }

@@ -349,3 +349,58 @@ fn rough_glass_scatters_from_both_sides() {
         }
     }
 }
+
+#[test]
+fn eta_crossed_sq_undoes_the_radiance_scaling_of_refraction() {
+    // A refracted sample's weight f·|cos θᵢ|/pdf carries 1/η′²; `eta_crossed_sq` is the
+    // η′² that undoes it (η′ = η entering from the normal's side, 1/η leaving), and 1 for
+    // a reflection. Smooth glass picks T with probability T, so its energy weight is 1.
+    let ns = Vec3::new(0.1, -0.2, 1.0).normalize();
+    let frame_z = |d: Vec3| d.dot(ns);
+    for (eta, alpha) in [(1.5f32, 1e-4f32), (1.0 / 1.33, 1e-4), (1.5, 0.3)] {
+        let bsdf = Bsdf::new(
+            ns,
+            ns,
+            Lobe::Dielectric(Dielectric {
+                tint: Vec3::ONE,
+                eta,
+                distrib: Microfacet::ggx(alpha, alpha),
+            }),
+        );
+        let (mut refracted, mut reflected) = (0, 0);
+        // From the normal's side and from the other, near normal and oblique.
+        let wos = [
+            Vec3::new(0.3, 0.25, 0.4),
+            Vec3::new(-0.6, 0.25, 1.3),
+            Vec3::new(0.8, -0.25, -0.1),
+            Vec3::new(-0.2, 0.1, -0.9),
+        ];
+        for (k, wo) in wos.map(Vec3::normalize).into_iter().enumerate() {
+            for i in 0..64 {
+                let u_lobe = (i as f32 + 0.5) / 64.0;
+                let u = Vec2::new(0.37 + 0.005 * k as f32, (i as f32 * 0.618).fract());
+                let Some(s) = bsdf.sample(wo, u_lobe, u) else {
+                    continue;
+                };
+                let scale = bsdf.eta_crossed_sq(wo, &s);
+                if frame_z(wo) * frame_z(s.wi) < 0.0 {
+                    refracted += 1;
+                    let etap = if frame_z(wo) > 0.0 { eta } else { 1.0 / eta };
+                    assert_eq!(scale, etap * etap, "η {eta}, wo {wo}");
+                    if alpha < 1e-3 {
+                        let w = s.f.x * bsdf.abs_cos(s.wi) / s.pdf;
+                        assert!((w * scale - 1.0).abs() < 1e-5, "η {eta}: {w} × {scale}");
+                    }
+                } else {
+                    reflected += 1;
+                    assert_eq!(scale, 1.0, "η {eta}, wo {wo}");
+                }
+            }
+        }
+        assert!(refracted > 0 && reflected > 0, "η {eta}: {refracted} / {reflected}");
+    }
+    let diffuse = Bsdf::new(ns, ns, Lobe::Diffuse(Diffuse { albedo: Vec3::ONE }));
+    let wo = Vec3::new(0.2, 0.1, 0.9).normalize();
+    let s = diffuse.sample(wo, 0.5, Vec2::new(0.3, 0.8)).unwrap();
+    assert_eq!(diffuse.eta_crossed_sq(wo, &s), 1.0);
+}

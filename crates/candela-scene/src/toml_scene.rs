@@ -176,6 +176,7 @@ struct RenderSection {
     resolution: Option<Spanned<[u32; 2]>>,
     spp: Option<u32>,
     max_depth: Option<u32>,
+    rr_depth: Option<u32>,
     seed: Option<u64>,
     mis: Option<MisMode>,
     light_sampler: Option<LightSamplerKind>,
@@ -193,6 +194,7 @@ fn parse_render(src: &Source, value: Item) -> Result<RenderSettings, LoadError> 
     }
     out.spp = r.spp.unwrap_or(out.spp);
     out.max_depth = r.max_depth.unwrap_or(out.max_depth);
+    out.rr_depth = r.rr_depth.unwrap_or(out.rr_depth);
     out.seed = r.seed.unwrap_or(out.seed);
     out.mis = r.mis.unwrap_or(out.mis);
     out.light_sampler = r.light_sampler.unwrap_or(out.light_sampler);

@@ -328,6 +328,7 @@ fn meshes_load_with_face_normals_and_flipped_uvs() {
 fn render_settings_follow_film_sampler_and_integrator() {
     let desc = load(&scene(
         r#"<integrator type="path"><integer name="max_depth" value="5"/>
+             <integer name="rr_depth" value="3"/>
              <boolean name="hide_emitters" value="false"/></integrator>
            <sensor type="perspective"><float name="fov" value="40"/>
              <sampler type="independent"><integer name="sample_count" value="7"/>
@@ -337,8 +338,8 @@ fn render_settings_follow_film_sampler_and_integrator() {
     ));
     let r = desc.render;
     assert_eq!(
-        (r.width, r.height, r.spp, r.seed, r.max_depth),
-        (30, 20, 7, 9, 4)
+        (r.width, r.height, r.spp, r.seed, r.max_depth, r.rr_depth),
+        (30, 20, 7, 9, 4, 3)
     );
     // Mitsuba's independent sampler stays independent; its low-discrepancy samplers become
     // Candela's Sobol' sampler, with a warning; no sampler keeps Candela's default.
@@ -381,6 +382,16 @@ fn render_settings_follow_film_sampler_and_integrator() {
     ));
     assert!(
         e.contains("scene.xml:2:25:") && e.contains("max_depth 0"),
+        "{e}"
+    );
+    // Both count scattering events, so rr_depth carries over as it is; Mitsuba's default
+    // is Candela's.
+    assert_eq!(load(&scene("")).render.rr_depth, 5);
+    let e = load_err(&scene(
+        "<integrator type=\"path\"><integer name=\"rr_depth\" value=\"-1\"/></integrator>",
+    ));
+    assert!(
+        e.contains("scene.xml:2:25:") && e.contains("rr_depth -1"),
         "{e}"
     );
 }

@@ -47,14 +47,14 @@ fn documented_example_loads_and_builds() {
 #[test]
 fn render_settings_and_camera() {
     let desc = parse(
-        "[render]\nresolution = [32, 16]\nspp = 3\nmax_depth = 0\nseed = 99\n\
+        "[render]\nresolution = [32, 16]\nspp = 3\nmax_depth = 0\nrr_depth = 2\nseed = 99\n\
          mis = \"none\"\nlight_sampler = \"uniform\"\n\n[camera]\ntype = \"pinhole\"\n\
          position = [1, 2, 3]\nlook_at = [0, 2, 0]\nup = [0, 0, 1]\nfov = 25.5\n",
     );
     let r = &desc.render;
     assert_eq!(
-        (r.width, r.height, r.spp, r.max_depth, r.seed),
-        (32, 16, 3, 0, 99)
+        (r.width, r.height, r.spp, r.max_depth, r.rr_depth, r.seed),
+        (32, 16, 3, 0, 2, 99)
     );
     assert_eq!(r.mis, MisMode::NeeOnly);
     assert_eq!(r.light_sampler, LightSamplerKind::Uniform);
@@ -63,7 +63,7 @@ fn render_settings_and_camera() {
     assert_eq!(c.look_at, Vec3::new(0.0, 2.0, 0.0));
     assert_eq!(c.up, Vec3::Z);
     assert_eq!(c.fov_y_deg, 25.5);
-    assert_eq!(c.span, Span::new("scene.toml", 9, 2));
+    assert_eq!(c.span, Span::new("scene.toml", 10, 2));
 
     for (name, mode) in [
         ("balance", MisMode::Balance),
@@ -90,8 +90,8 @@ fn render_settings_and_camera() {
     // Defaults when the sections are absent.
     let d = parse("");
     assert_eq!(
-        (d.render.width, d.render.spp, d.render.max_depth),
-        (512, 64, 8)
+        (d.render.width, d.render.spp, d.render.max_depth, d.render.rr_depth),
+        (512, 64, 8, 5)
     );
     assert_eq!(d.camera.fov_y_deg, 40.0);
 }

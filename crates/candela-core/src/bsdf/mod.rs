@@ -323,6 +323,25 @@ impl Bsdf {
         self.lobe.is_delta()
     }
 
+    /// The square of the relative index η′ that the sampled direction `s` crossed: η′² for
+    /// a refraction, 1 otherwise. Refraction scales radiance by 1/η′², so the product of
+    /// these along a path undoes that scaling: Russian roulette judges a path by what it
+    /// will carry out of the glass, not by the medium it is in (pbrt-v4's `etaScale`,
+    /// Mitsuba's η²).
+    pub fn eta_crossed_sq(&self, wo: Vec3, s: &BsdfSample) -> f32 {
+        match &self.lobe {
+            Lobe::Dielectric(d) if s.flags.contains(BsdfFlags::TRANSMISSION) => {
+                let etap = if wo.dot(self.frame.n) > 0.0 {
+                    d.eta
+                } else {
+                    1.0 / d.eta
+                };
+                etap * etap
+            }
+            _ => 1.0,
+        }
+    }
+
     /// |cos θ| of `wi` against the shading normal.
     #[inline]
     pub fn abs_cos(&self, wi: Vec3) -> f32 {

@@ -45,13 +45,10 @@ pub(crate) fn integrator(ctx: &mut Ctx, node: &Node) -> Result<(), LoadError> {
         ctx.desc.render.max_depth = UNLIMITED_DEPTH;
     }
     if let Some(rr) = node.integer("rr_depth")? {
-        if rr != 5 {
-            let p = node.prop("rr_depth").expect("read just now");
-            ctx.warn(
-                p,
-                "rr_depth is ignored: Candela's Russian roulette starts after 3 bounces",
-            );
-        }
+        let p = node.prop("rr_depth").expect("read just now");
+        // Both count scattering events, so Mitsuba's value carries over as it is.
+        ctx.desc.render.rr_depth = u32::try_from(rr)
+            .map_err(|_| p.error(format!("rr_depth {rr} is invalid: use 0 or more")))?;
     }
     ctx.desc.render.hide_emitters = node.boolean("hide_emitters")?.unwrap_or(false);
     ctx.check_unused(node)
