@@ -14,10 +14,12 @@
 mod binary;
 mod box8;
 mod extents;
+mod quant8;
 mod wide;
 
 pub use binary::{Bvh, BvhNode, SahCost};
 pub use box8::{hit8_scalar, BoxTest, Planes8, Ray8, ScalarBoxes, Simd, T_MAX_SCALE};
 #[cfg(target_arch = "x86_64")]
 pub use box8::{Avx2Boxes, SseBoxes};
-pub use wide::{prefetch, Node8, WideBvh};
+pub use quant8::QBoxes8;
+pub use wide::{prefetch, Node8, QNode8, WideBvh, WideNode};
