@@ -14,6 +14,9 @@
 //! The SIMD kernels ([`Simd`]) are chosen once, at build: AVX2 box and triangle tests
 //! where the CPU has them, else SSE; [`Accel::build_for`] forces one (the tests run each the CPU has
 //! against the scalar one). Every kernel finds the same hits, bit for bit.
+//!
+//! [`NodeLayout`] picks the wide nodes: full planes (the default) or quantized boxes
+//! (half the node memory; [`Accel::build_layout`]).
 
 mod block;
 mod lanes;

@@ -225,60 +225,54 @@ mod x86 {
 
         #[inline(always)]
         unsafe fn hit8(r: &SseRay, planes: &Planes8, t_max: f32) -> (u32, [f32; 8]) {
-            let mut out = [0.0f32; 8];
-            let mut mask = 0;
-            for half in 0..2 {
-                let mut t_near = _mm_setzero_ps();
-                let mut t_far = _mm_set1_ps(t_max);
-                for axis in 0..3 {
-                    let n = r.near[axis];
-                    let near = _mm_loadu_ps(planes.get_unchecked(n).as_ptr().add(4 * half));
-                    let far = _mm_loadu_ps(planes.get_unchecked(n ^ 1).as_ptr().add(4 * half));
-                    t_near =
-                        _mm_max_ps(_mm_mul_ps(_mm_sub_ps(near, r.o[axis]), r.inv[axis]), t_near);
-                    t_far = _mm_min_ps(
-                        _mm_mul_ps(_mm_sub_ps(far, r.o[axis]), r.inv_far[axis]),
-                        t_far,
-                    );
-                }
-                mask |= (_mm_movemask_ps(_mm_cmple_ps(t_near, t_far)) as u32) << (4 * half);
-                _mm_storeu_ps(out.as_mut_ptr().add(4 * half), t_near);
-            }
-            (mask, out)
+            slab_sse(r, t_max, |_, row, half| {
+                _mm_loadu_ps(planes.get_unchecked(row).as_ptr().add(4 * half))
+            })
         }
 
         #[inline(always)]
         unsafe fn hit8q(r: &SseRay, boxes: &QBoxes8, t_max: f32) -> (u32, [f32; 8]) {
-            // Four bytes to four floats with SSE2 only: widen with zeros twice, convert.
-            let row = |row: usize, half: usize| {
+            slab_sse(r, t_max, |axis, row, half| {
+                // Four bytes to four floats with SSE2 only: widen with zeros twice, convert.
                 let bytes = boxes.q.get_unchecked(row).as_ptr().add(4 * half);
                 let v = _mm_cvtsi32_si128((bytes as *const i32).read_unaligned());
                 let zero = _mm_setzero_si128();
-                _mm_cvtepi32_ps(_mm_unpacklo_epi16(_mm_unpacklo_epi8(v, zero), zero))
-            };
-            let mut out = [0.0f32; 8];
-            let mut mask = 0;
-            for half in 0..2 {
-                let mut t_near = _mm_setzero_ps();
-                let mut t_far = _mm_set1_ps(t_max);
-                for axis in 0..3 {
-                    let n = r.near[axis];
-                    let origin = _mm_set1_ps(*boxes.origin.get_unchecked(axis));
-                    let step = _mm_set1_ps(*boxes.step.get_unchecked(axis));
-                    let near = _mm_add_ps(_mm_mul_ps(row(n, half), step), origin);
-                    let far = _mm_add_ps(_mm_mul_ps(row(n ^ 1, half), step), origin);
-                    t_near =
-                        _mm_max_ps(_mm_mul_ps(_mm_sub_ps(near, r.o[axis]), r.inv[axis]), t_near);
-                    t_far = _mm_min_ps(
-                        _mm_mul_ps(_mm_sub_ps(far, r.o[axis]), r.inv_far[axis]),
-                        t_far,
-                    );
-                }
-                mask |= (_mm_movemask_ps(_mm_cmple_ps(t_near, t_far)) as u32) << (4 * half);
-                _mm_storeu_ps(out.as_mut_ptr().add(4 * half), t_near);
-            }
-            (mask, out)
+                let q = _mm_cvtepi32_ps(_mm_unpacklo_epi16(_mm_unpacklo_epi8(v, zero), zero));
+                let step = _mm_set1_ps(*boxes.step.get_unchecked(axis));
+                _mm_add_ps(
+                    _mm_mul_ps(q, step),
+                    _mm_set1_ps(*boxes.origin.get_unchecked(axis)),
+                )
+            })
         }
+    }
+
+    /// The slab test in two halves; `plane(axis, row, half)` gives four lanes of plane
+    /// row `row` (of [`Planes8`]'s order).
+    #[inline(always)]
+    unsafe fn slab_sse(
+        r: &SseRay,
+        t_max: f32,
+        plane: impl Fn(usize, usize, usize) -> __m128,
+    ) -> (u32, [f32; 8]) {
+        let mut out = [0.0f32; 8];
+        let mut mask = 0;
+        for half in 0..2 {
+            let mut t_near = _mm_setzero_ps();
+            let mut t_far = _mm_set1_ps(t_max);
+            for axis in 0..3 {
+                let n = r.near[axis];
+                let (near, far) = (plane(axis, n, half), plane(axis, n ^ 1, half));
+                t_near = _mm_max_ps(_mm_mul_ps(_mm_sub_ps(near, r.o[axis]), r.inv[axis]), t_near);
+                t_far = _mm_min_ps(
+                    _mm_mul_ps(_mm_sub_ps(far, r.o[axis]), r.inv_far[axis]),
+                    t_far,
+                );
+            }
+            mask |= (_mm_movemask_ps(_mm_cmple_ps(t_near, t_far)) as u32) << (4 * half);
+            _mm_storeu_ps(out.as_mut_ptr().add(4 * half), t_near);
+        }
+        (mask, out)
     }
 
     /// One 8-lane AVX2 register.
@@ -310,57 +304,53 @@ mod x86 {
         #[inline]
         #[target_feature(enable = "avx2")]
         unsafe fn hit8(r: &Avx2Ray, planes: &Planes8, t_max: f32) -> (u32, [f32; 8]) {
-            let mut t_near = _mm256_setzero_ps();
-            let mut t_far = _mm256_set1_ps(t_max);
-            for axis in 0..3 {
-                let n = r.near[axis];
-                let near = _mm256_loadu_ps(planes.get_unchecked(n).as_ptr());
-                let far = _mm256_loadu_ps(planes.get_unchecked(n ^ 1).as_ptr());
-                t_near = _mm256_max_ps(
-                    _mm256_mul_ps(_mm256_sub_ps(near, r.o[axis]), r.inv[axis]),
-                    t_near,
-                );
-                t_far = _mm256_min_ps(
-                    _mm256_mul_ps(_mm256_sub_ps(far, r.o[axis]), r.inv_far[axis]),
-                    t_far,
-                );
-            }
-            let mask = _mm256_movemask_ps(_mm256_cmp_ps::<_CMP_LE_OQ>(t_near, t_far)) as u32;
-            let mut out = [0.0f32; 8];
-            _mm256_storeu_ps(out.as_mut_ptr(), t_near);
-            (mask, out)
+            slab_avx2(r, t_max, |_, row| {
+                _mm256_loadu_ps(planes.get_unchecked(row).as_ptr())
+            })
         }
 
         #[inline]
         #[target_feature(enable = "avx2")]
         unsafe fn hit8q(r: &Avx2Ray, boxes: &QBoxes8, t_max: f32) -> (u32, [f32; 8]) {
-            let row = |row: usize| {
+            slab_avx2(r, t_max, |axis, row| {
                 let bytes = boxes.q.get_unchecked(row).as_ptr() as *const __m128i;
-                _mm256_cvtepi32_ps(_mm256_cvtepu8_epi32(_mm_loadl_epi64(bytes)))
-            };
-            let mut t_near = _mm256_setzero_ps();
-            let mut t_far = _mm256_set1_ps(t_max);
-            for axis in 0..3 {
-                let n = r.near[axis];
-                let origin = _mm256_set1_ps(*boxes.origin.get_unchecked(axis));
-                let step = _mm256_set1_ps(*boxes.step.get_unchecked(axis));
+                let q = _mm256_cvtepi32_ps(_mm256_cvtepu8_epi32(_mm_loadl_epi64(bytes)));
                 // Multiply, then add: not fused, so as the scalar kernel rounds.
-                let near = _mm256_add_ps(_mm256_mul_ps(row(n), step), origin);
-                let far = _mm256_add_ps(_mm256_mul_ps(row(n ^ 1), step), origin);
-                t_near = _mm256_max_ps(
-                    _mm256_mul_ps(_mm256_sub_ps(near, r.o[axis]), r.inv[axis]),
-                    t_near,
-                );
-                t_far = _mm256_min_ps(
-                    _mm256_mul_ps(_mm256_sub_ps(far, r.o[axis]), r.inv_far[axis]),
-                    t_far,
-                );
-            }
-            let mask = _mm256_movemask_ps(_mm256_cmp_ps::<_CMP_LE_OQ>(t_near, t_far)) as u32;
-            let mut out = [0.0f32; 8];
-            _mm256_storeu_ps(out.as_mut_ptr(), t_near);
-            (mask, out)
+                let step = _mm256_set1_ps(*boxes.step.get_unchecked(axis));
+                _mm256_add_ps(
+                    _mm256_mul_ps(q, step),
+                    _mm256_set1_ps(*boxes.origin.get_unchecked(axis)),
+                )
+            })
         }
+    }
+
+    /// The slab test; `plane(axis, row)` gives plane row `row` (of [`Planes8`]'s order).
+    #[inline]
+    #[target_feature(enable = "avx2")]
+    unsafe fn slab_avx2(
+        r: &Avx2Ray,
+        t_max: f32,
+        plane: impl Fn(usize, usize) -> __m256,
+    ) -> (u32, [f32; 8]) {
+        let mut t_near = _mm256_setzero_ps();
+        let mut t_far = _mm256_set1_ps(t_max);
+        for axis in 0..3 {
+            let n = r.near[axis];
+            let (near, far) = (plane(axis, n), plane(axis, n ^ 1));
+            t_near = _mm256_max_ps(
+                _mm256_mul_ps(_mm256_sub_ps(near, r.o[axis]), r.inv[axis]),
+                t_near,
+            );
+            t_far = _mm256_min_ps(
+                _mm256_mul_ps(_mm256_sub_ps(far, r.o[axis]), r.inv_far[axis]),
+                t_far,
+            );
+        }
+        let mask = _mm256_movemask_ps(_mm256_cmp_ps::<_CMP_LE_OQ>(t_near, t_far)) as u32;
+        let mut out = [0.0f32; 8];
+        _mm256_storeu_ps(out.as_mut_ptr(), t_near);
+        (mask, out)
     }
 }
 

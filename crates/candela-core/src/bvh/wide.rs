@@ -66,9 +66,8 @@ pub trait WideNode: Copy {
     /// # Safety
     /// The CPU must support kernel `K`.
     unsafe fn hit<K: BoxTest>(&self, ray: &K::Prepared, t_max: f32) -> (u32, [f32; 8]);
-    fn child(&self) -> &[u32; WIDTH];
-    fn count(&self) -> &[u8; WIDTH];
-    fn leaves(&self) -> u8;
+    /// `child`, `count` and `leaves`, as in [`Node8`].
+    fn links(&self) -> (&[u32; WIDTH], &[u8; WIDTH], u8);
 }
 
 impl WideNode for Node8 {
@@ -77,16 +76,8 @@ impl WideNode for Node8 {
         K::hit8(ray, &self.planes, t_max)
     }
     #[inline(always)]
-    fn child(&self) -> &[u32; WIDTH] {
-        &self.child
-    }
-    #[inline(always)]
-    fn count(&self) -> &[u8; WIDTH] {
-        &self.count
-    }
-    #[inline(always)]
-    fn leaves(&self) -> u8 {
-        self.leaves
+    fn links(&self) -> (&[u32; WIDTH], &[u8; WIDTH], u8) {
+        (&self.child, &self.count, self.leaves)
     }
 }
 
@@ -143,16 +134,8 @@ impl WideNode for QNode8 {
         (mask & self.used as u32, t)
     }
     #[inline(always)]
-    fn child(&self) -> &[u32; WIDTH] {
-        &self.child
-    }
-    #[inline(always)]
-    fn count(&self) -> &[u8; WIDTH] {
-        &self.count
-    }
-    #[inline(always)]
-    fn leaves(&self) -> u8 {
-        self.leaves
+    fn links(&self) -> (&[u32; WIDTH], &[u8; WIDTH], u8) {
+        (&self.child, &self.count, self.leaves)
     }
 }
 
@@ -329,16 +312,17 @@ impl<N: WideNode> WideBvh<N> {
         loop {
             let node = &self.nodes[current];
             let (mut mask, t_near) = node.hit::<K>(&r, t_max * T_MAX_SCALE);
+            let (child, count, _) = node.links();
             if mask & mask.wrapping_sub(1) == 0 {
                 // One child or none: no sorting, and an interior child is next.
                 if mask != 0 {
                     let lane = mask.trailing_zeros() as usize;
-                    let count = node.count()[lane] as u32;
-                    if count == 0 {
-                        current = node.child()[lane] as usize;
+                    let prims = count[lane] as u32;
+                    if prims == 0 {
+                        current = child[lane] as usize;
                         continue;
                     }
-                    t_max = leaf(node.child()[lane], count, t_max);
+                    t_max = leaf(child[lane], prims, t_max);
                 }
             } else {
                 // Push the hit children farthest first so that the nearest is popped next.
@@ -347,8 +331,8 @@ impl<N: WideNode> WideBvh<N> {
                     let lane = mask.trailing_zeros() as usize;
                     mask &= mask - 1;
                     let entry = Entry {
-                        child: node.child()[lane],
-                        count: node.count()[lane] as u32,
+                        child: child[lane],
+                        count: count[lane] as u32,
                         t: t_near[lane],
                     };
                     // It waits on the stack: have its memory on the way meanwhile
@@ -418,26 +402,27 @@ impl<N: WideNode> WideBvh<N> {
         loop {
             let node = &self.nodes[current];
             let (mask, _) = node.hit::<K>(&r, t_box);
-            let leaves = node.leaves() as u32;
+            let (child, count, leaves) = node.links();
+            let leaves = leaves as u32;
             let mut hit_leaves = mask & leaves;
             while hit_leaves != 0 {
                 let lane = hit_leaves.trailing_zeros() as usize;
                 hit_leaves &= hit_leaves - 1;
-                if leaf(node.child()[lane], node.count()[lane] as u32, t_max) {
+                if leaf(child[lane], count[lane] as u32, t_max) {
                     return true;
                 }
             }
             let mut inner = mask & !leaves;
             if inner != 0 {
-                current = node.child()[inner.trailing_zeros() as usize] as usize;
+                current = child[inner.trailing_zeros() as usize] as usize;
                 inner &= inner - 1;
                 while inner != 0 {
-                    let child = node.child()[inner.trailing_zeros() as usize];
+                    let next = child[inner.trailing_zeros() as usize];
                     prefetch(
-                        self.nodes.as_ptr().wrapping_add(child as usize) as *const u8,
+                        self.nodes.as_ptr().wrapping_add(next as usize) as *const u8,
                         node_lines,
                     );
-                    stack[sp].write(child);
+                    stack[sp].write(next);
                     sp += 1;
                     inner &= inner - 1;
                 }
