@@ -5,6 +5,9 @@
 # 2. Closest-hit and any-hit rays/s on one core (this script pins itself to one CPU) on
 #    the Cornell box and on a generated room of 589 836 triangles, Candela and Embree
 #    tracing the same diffuse-bounce rays, alternately, in one run.
+# 3. The same for Candela alone on `mixed`: a room whose leaf blocks mix analytic spheres
+#    and alpha-masked triangles with plain ones (Embree via embreex has triangles only).
+# CANDELA_NODES=full|quantized picks the BVH's node layout (default: the library's).
 set -euo pipefail
 here="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"
 root="$(dirname "$here")"
@@ -18,5 +21,5 @@ echo "== BVH build, 2 threads"
 RAYON_NUM_THREADS=2 "$example" build | tee "$out/build.json"
 echo "== traversal, one core"
 cpu="$(python3 -c 'import os; print(max(os.sched_getaffinity(0)))')"
-taskset -c "$cpu" "$here/.venv/bin/python" "$here/traversal.py" "$example" "$out" "$repeats" cornell room \
+taskset -c "$cpu" "$here/.venv/bin/python" "$here/traversal.py" "$example" "$out" "$repeats" cornell room mixed \
     | tee "$out/traversal.md"

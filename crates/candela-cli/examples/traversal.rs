@@ -2,8 +2,10 @@
 //!
 //! `traversal rays SCENE OUT_DIR [RAYS]` makes a triangle soup and diffuse-bounce rays and
 //! times Candela's closest-hit and any-hit queries on them, single-threaded:
-//! - `SCENE` is `cornell` (scenes/cornell.toml, its camera) or `room` (a generated room of
-//!   16 displaced spheres, 589 836 triangles, seen from inside);
+//! - `SCENE` is `cornell` (scenes/cornell.toml, its camera), `room` (a generated room of
+//!   16 displaced spheres, 589 836 triangles, seen from inside) or `mixed` (a coarser room
+//!   with analytic spheres and alpha-masked triangles mixed into its leaf blocks: Candela
+//!   only, as embreex has only triangles);
 //! - rays: one primary ray per jittered pixel sample, and from each primary hit a
 //!   cosine-distributed bounce ray about the geometric normal, origin offset as the
 //!   renderer does; only the bounce rays are timed and written.
@@ -13,7 +15,8 @@
 //! `bench/traversal.py`, which traces the same rays with Embree and compares.
 //!
 //! `CANDELA_SIMD=scalar|sse|avx2` forces the kernels (default: the best the CPU has; the
-//! JSON line says which ran).
+//! JSON line says which ran), `CANDELA_NODES=full|quantized` the BVH's node layout
+//! (default: the library's).
 //!
 //! `traversal build [TRIANGLES]` times the BVH build of a generated displaced-sphere mesh
 //! (default 10⁶ triangles) on the rayon pool (`RAYON_NUM_THREADS=2` for two cores).
@@ -22,8 +25,8 @@ use std::io::Write;
 use std::path::Path;
 use std::time::Instant;
 
-use candela_core::accel::{accept_all, Accel, Shape, Simd};
-use candela_core::geometry::Ray;
+use candela_core::accel::{Accel, NodeLayout, Shape, Simd};
+use candela_core::geometry::{Ray, TriangleHit};
 use candela_core::math::{offset_ray_origin, Frame};
 use candela_core::sampler::Pcg32;
 use candela_core::sampling::sample_cosine_hemisphere;
@@ -126,15 +129,80 @@ fn shapes(tris: &[[Vec3; 3]]) -> Vec<Shape> {
     tris.iter().map(|&t| Shape::Triangle(t)).collect()
 }
 
-fn normal(t: &[Vec3; 3]) -> Vec3 {
-    (t[1] - t[0]).cross(t[2] - t[0]).normalize_or_zero()
+/// The `mixed` scene: [`room`] at a quarter of the triangles, 6 000 analytic spheres
+/// (on the floor, on the displaced spheres' surfaces, and floating), and 20 000 small
+/// alpha-masked triangles (a barycentric checker, half of each cut away) drifting like
+/// leaves through the room. Spheres and masked triangles sit next to the room's own
+/// triangles, so the leaf blocks mix every kind.
+fn mixed() -> Vec<Shape> {
+    let mut shapes = shapes(&room(96, 48));
+    let mut rng = Pcg32::new(3, 1);
+    let mut u = || rng.uniform_f32();
+    for k in 0..6000 {
+        let (center, radius) = match k % 3 {
+            0 => (Vec3::new(20.0 * u() - 10.0, 0.1, 20.0 * u() - 10.0), 0.1),
+            1 => {
+                // On one of the 16 displaced spheres, near its surface.
+                let (i, j) = (k / 3 % 4, k / 12 % 4);
+                let c = Vec3::new(
+                    -6.0 + 4.0 * i as f32,
+                    1.6 + 0.5 * ((i + j) % 3) as f32,
+                    -6.0 + 4.0 * j as f32,
+                );
+                let d = Vec3::new(u() - 0.5, u() - 0.5, u() - 0.5).normalize_or(Vec3::Y);
+                (c + d * 1.45, 0.04 + 0.08 * u())
+            }
+            _ => (
+                Vec3::new(18.0 * u() - 9.0, 7.0 * u() + 0.5, 18.0 * u() - 9.0),
+                0.05,
+            ),
+        };
+        shapes.push(Shape::Sphere { center, radius });
+    }
+    for _ in 0..20000 {
+        let c = Vec3::new(18.0 * u() - 9.0, 7.0 * u() + 0.5, 18.0 * u() - 9.0);
+        let e = |u: &mut dyn FnMut() -> f32| Vec3::new(u() - 0.5, u() - 0.5, u() - 0.5) * 0.4;
+        shapes.push(Shape::Triangle([c, c + e(&mut u), c + e(&mut u)]));
+    }
+    shapes
+}
+
+/// Primitives of the `mixed` scene whose hits go through [`leaf_mask`]: its loose
+/// triangles, the last 20 000.
+fn masked(shapes: &[Shape]) -> impl Fn(u32) -> bool + '_ {
+    move |i| i as usize >= shapes.len() - 20000
+}
+
+/// The alpha mask of the `mixed` scene's loose triangles: a 4 × 4 checker in
+/// barycentrics, half of each triangle cut away.
+fn leaf_mask(_: u32, h: &TriangleHit) -> bool {
+    ((h.b1 * 4.0) as u32 + (h.b2 * 4.0) as u32).is_multiple_of(2)
+}
+
+/// The geometric normal of shape `s` at `p`.
+fn normal(s: &Shape, p: Vec3) -> Vec3 {
+    match *s {
+        Shape::Triangle(t) => (t[1] - t[0]).cross(t[2] - t[0]).normalize_or_zero(),
+        Shape::Sphere { center, .. } => (p - center).normalize_or_zero(),
+    }
 }
 
 /// Film position in [0, 1)² to primary ray.
 type CameraFn = Box<dyn Fn(Vec2) -> Ray>;
 
+/// A pinhole in a corner of the room looking at its middle, 60° field of view.
+fn room_camera() -> CameraFn {
+    let (eye, target) = (Vec3::new(-9.0, 6.0, 9.0), Vec3::new(0.0, 1.5, 0.0));
+    let frame = Frame::from_z((eye - target).normalize());
+    let tan = (30f32).to_radians().tan();
+    Box::new(move |f: Vec2| {
+        let d = Vec3::new((2.0 * f.x - 1.0) * tan, (1.0 - 2.0 * f.y) * tan, -1.0);
+        Ray::new(eye, frame.to_world(d).normalize())
+    })
+}
+
 fn rays_bench(scene: &str, out: &Path, n_rays: usize) {
-    let (tris, camera): (Vec<[Vec3; 3]>, CameraFn) = match scene {
+    let (shapes, camera): (Vec<Shape>, CameraFn) = match scene {
         "cornell" => {
             let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../../scenes/cornell.toml");
             let mut desc = candela_scene::load_scene(Path::new(path)).expect("cornell.toml");
@@ -145,29 +213,26 @@ fn rays_bench(scene: &str, out: &Path, n_rays: usize) {
                 scene.spheres.is_empty(),
                 "the benchmark traces triangles only"
             );
-            let tris = scene
+            let tris: Vec<[Vec3; 3]> = scene
                 .meshes
                 .iter()
                 .flat_map(|m| (0..m.indices.len() as u32).map(move |t| m.vertices(t)))
                 .collect();
             let cam = scene.camera.clone();
-            (tris, Box::new(move |f: Vec2| cam.generate_ray(f * 512.0)))
+            (
+                shapes(&tris),
+                Box::new(move |f: Vec2| cam.generate_ray(f * 512.0)),
+            )
         }
-        "room" => {
-            // A pinhole in a corner looking at the middle of the room, 60° field of view.
-            let (eye, target) = (Vec3::new(-9.0, 6.0, 9.0), Vec3::new(0.0, 1.5, 0.0));
-            let frame = Frame::from_z((eye - target).normalize());
-            let tan = (30f32).to_radians().tan();
-            let cam = move |f: Vec2| {
-                let d = Vec3::new((2.0 * f.x - 1.0) * tan, (1.0 - 2.0 * f.y) * tan, -1.0);
-                Ray::new(eye, frame.to_world(d).normalize())
-            };
-            (room(192, 96), Box::new(cam))
-        }
-        other => panic!("unknown scene {other:?}: cornell or room"),
+        "room" => (shapes(&room(192, 96)), room_camera()),
+        "mixed" => (mixed(), room_camera()),
+        other => panic!("unknown scene {other:?}: cornell, room or mixed"),
     };
+    // Only the mixed scene has alpha masks; the filter is the same function for all.
+    let is_masked = masked(&shapes);
+    let filtered = |i: u32| scene == "mixed" && is_masked(i);
     let t0 = Instant::now();
-    let accel = Accel::build_for(&shapes(&tris), |_| false, simd_from_env());
+    let accel = Accel::build_layout(&shapes, filtered, simd_from_env(), layout_from_env());
     let build_s = t0.elapsed().as_secs_f64();
 
     // Diffuse-bounce rays from primary hits.
@@ -176,15 +241,18 @@ fn rays_bench(scene: &str, out: &Path, n_rays: usize) {
     while rays.len() < n_rays {
         let film = Vec2::new(rng.uniform_f32(), rng.uniform_f32());
         let primary = camera(film);
-        let Some(hit) = accel.intersect(&primary, f32::INFINITY, accept_all) else {
+        let Some(hit) = accel.intersect(&primary, f32::INFINITY, leaf_mask) else {
             continue;
         };
-        let tri = &tris[hit.prim as usize];
-        let mut n = normal(tri);
+        let shape = &shapes[hit.prim as usize];
+        let p = match *shape {
+            Shape::Triangle(t) => t[0] * (1.0 - hit.b1 - hit.b2) + t[1] * hit.b1 + t[2] * hit.b2,
+            Shape::Sphere { .. } => primary.o + primary.d * hit.t,
+        };
+        let mut n = normal(shape, p);
         if n.dot(primary.d) > 0.0 {
             n = -n;
         }
-        let p = tri[0] * (1.0 - hit.b1 - hit.b2) + tri[1] * hit.b1 + tri[2] * hit.b2;
         let d = Frame::from_z(n).to_world(sample_cosine_hemisphere(Vec2::new(
             rng.uniform_f32(),
             rng.uniform_f32(),
@@ -205,11 +273,22 @@ fn rays_bench(scene: &str, out: &Path, n_rays: usize) {
     std::fs::create_dir_all(out).expect("OUT_DIR");
     let floats =
         |v: &mut dyn Iterator<Item = f32>| -> Vec<u8> { v.flat_map(f32::to_le_bytes).collect() };
-    std::fs::write(
-        out.join("tris.f32"),
-        floats(&mut tris.iter().flatten().flat_map(|v| v.to_array())),
-    )
-    .unwrap();
+    let tris: Vec<[Vec3; 3]> = shapes
+        .iter()
+        .filter_map(|s| match *s {
+            Shape::Triangle(t) => Some(t),
+            Shape::Sphere { .. } => None,
+        })
+        .collect();
+    let spheres = shapes.len() - tris.len();
+    if spheres == 0 {
+        // Embree's input: only for scenes of plain triangles.
+        std::fs::write(
+            out.join("tris.f32"),
+            floats(&mut tris.iter().flatten().flat_map(|v| v.to_array())),
+        )
+        .unwrap();
+    }
     std::fs::write(
         out.join("rays.f32"),
         floats(
@@ -225,10 +304,15 @@ fn rays_bench(scene: &str, out: &Path, n_rays: usize) {
         f.write_all(&t.to_le_bytes()).unwrap();
     }
     let n = rays.len() as f64;
+    let (node_bytes, block_bytes) = accel.memory();
+    let masked_count = (0..shapes.len() as u32).filter(|&i| filtered(i)).count();
     println!(
-        "{{\"scene\": \"{scene}\", \"simd\": \"{:?}\", \"triangles\": {}, \"rays\": {}, \"hit\": {found}, \
-         \"build_s\": {build_s:.4}, \"closest_mrays_s\": {:.3}, \"any_mrays_s\": {:.3}}}",
+        "{{\"scene\": \"{scene}\", \"simd\": \"{:?}\", \"layout\": \"{:?}\", \"triangles\": {}, \
+         \"spheres\": {spheres}, \"masked\": {masked_count}, \"rays\": {}, \"hit\": {found}, \
+         \"build_s\": {build_s:.4}, \"closest_mrays_s\": {:.3}, \"any_mrays_s\": {:.3}, \
+         \"node_bytes\": {node_bytes}, \"block_bytes\": {block_bytes}}}",
         accel.simd(),
+        accel.layout(),
         tris.len(),
         rays.len(),
         n / closest / 1e6,
@@ -241,7 +325,7 @@ fn rays_bench(scene: &str, out: &Path, n_rays: usize) {
 #[inline(never)]
 fn trace_closest(accel: &Accel, rays: &[Ray], hits: &mut [(u32, f32)]) {
     for (r, h) in rays.iter().zip(hits.iter_mut()) {
-        if let Some(hit) = accel.intersect(r, f32::INFINITY, accept_all) {
+        if let Some(hit) = accel.intersect(r, f32::INFINITY, leaf_mask) {
             *h = (hit.prim, hit.t);
         }
     }
@@ -251,7 +335,7 @@ fn trace_closest(accel: &Accel, rays: &[Ray], hits: &mut [(u32, f32)]) {
 #[inline(never)]
 fn trace_any(accel: &Accel, rays: &[Ray]) -> usize {
     rays.iter()
-        .filter(|r| accel.occluded(r, f32::INFINITY, accept_all))
+        .filter(|r| accel.occluded(r, f32::INFINITY, leaf_mask))
         .count()
 }
 
@@ -264,6 +348,16 @@ fn simd_from_env() -> Simd {
         Ok("avx2") => Simd::Avx2,
         Ok(other) => panic!("CANDELA_SIMD={other:?}: scalar, sse or avx2"),
         Err(_) => Simd::best(),
+    }
+}
+
+/// The node layout: `CANDELA_NODES=full|quantized`, else the library's default.
+fn layout_from_env() -> NodeLayout {
+    match std::env::var("CANDELA_NODES").as_deref() {
+        Ok("full") => NodeLayout::Full,
+        Ok("quantized") => NodeLayout::Quantized,
+        Ok(other) => panic!("CANDELA_NODES={other:?}: full or quantized"),
+        Err(_) => NodeLayout::default(),
     }
 }
 
@@ -295,7 +389,7 @@ fn build_bench(n: usize) {
     let mut times: Vec<(f64, f64)> = (0..5)
         .map(|_| {
             let (t, cpu) = (Instant::now(), cpu_seconds());
-            let accel = Accel::build(&shapes, |_| false);
+            let accel = Accel::build_layout(&shapes, |_| false, Simd::best(), layout_from_env());
             let s = (t.elapsed().as_secs_f64(), cpu_seconds() - cpu);
             assert!(!accel.bounds().is_empty());
             s

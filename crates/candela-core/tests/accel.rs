@@ -14,11 +14,13 @@
 //! fill and mix lane by lane).
 //!
 //! Every SIMD kernel set the CPU has (`Simd::available`, always including the scalar
-//! fallback) is checked the same way, and each must return exactly what the scalar one
-//! returns (same primitive even in ties, same t and barycentric bits): their box tests
-//! give the same bits, so they walk the tree in the same order.
+//! fallback) is checked the same way, with both node layouts (full planes and quantized
+//! boxes), and each must return exactly what the scalar one of its layout returns (same
+//! primitive even in ties, same t and barycentric bits): their box tests give the same
+//! bits, so they walk the tree in the same order. Across layouts the order differs
+//! (quantized boxes are entered a little earlier), so there only ties may differ.
 
-use candela_core::accel::{accept_all, Accel, Hit, Shape, Simd};
+use candela_core::accel::{accept_all, Accel, Hit, NodeLayout, Shape, Simd};
 use candela_core::bvh::Bvh;
 use candela_core::geometry::{intersect_sphere, Aabb, Ray, WatertightRay};
 use candela_core::sampler::Pcg32;
@@ -63,8 +65,9 @@ fn boxes(shapes: &[Shape]) -> Vec<Aabb> {
         .collect()
 }
 
-/// Random rays: origins in and around `bounds`, directions uniform, a quarter of them
-/// with one or two components exactly ±0 (axis-parallel), some aimed at a vertex.
+/// Random rays: origins in and around `bounds` (a fifth inside a primitive's box),
+/// directions uniform, a quarter of them with one or two components exactly ±0
+/// (axis-parallel), some aimed at a vertex.
 fn random_rays(rng: &mut Pcg32, shapes: &[Shape], bounds: Aabb, n: usize) -> Vec<Ray> {
     let (lo, ext) = if bounds.is_empty() {
         (Vec3::splat(-1.0), Vec3::splat(2.0))
@@ -74,7 +77,14 @@ fn random_rays(rng: &mut Pcg32, shapes: &[Shape], bounds: Aabb, n: usize) -> Vec
     };
     (0..n)
         .map(|i| {
-            let o = lo + v3(rng) * ext;
+            let mut o = lo + v3(rng) * ext;
+            if i % 5 == 4 && !shapes.is_empty() {
+                // From inside a primitive's box (and so inside every box above it).
+                let b = shapes[rng.next_u32() as usize % shapes.len()].bounds();
+                if b.min.is_finite() && b.max.is_finite() {
+                    o = b.min + v3(rng) * (b.max - b.min);
+                }
+            }
             let mut d = v3(rng) * 2.0 - 1.0;
             match i % 8 {
                 0 => d.x = 0.0,
@@ -104,11 +114,17 @@ fn random_rays(rng: &mut Pcg32, shapes: &[Shape], bounds: Aabb, n: usize) -> Vec
 /// Checks every ray against brute force and the binary BVH, with every kernel set;
 /// returns how many hit.
 fn check_scene(name: &str, shapes: &[Shape], rays: &[Ray], rng: &mut Pcg32) -> usize {
-    let accels: Vec<Accel> = Simd::available()
-        .into_iter()
-        .map(|simd| Accel::build_for(shapes, |_| false, simd))
+    let layouts = [NodeLayout::Full, NodeLayout::Quantized];
+    let accels: Vec<Vec<Accel>> = layouts
+        .iter()
+        .map(|&layout| {
+            Simd::available()
+                .into_iter()
+                .map(|simd| Accel::build_layout(shapes, |_| false, simd, layout))
+                .collect()
+        })
         .collect();
-    assert_eq!(accels[0].simd(), Simd::Scalar);
+    assert_eq!(accels[0][0].simd(), Simd::Scalar);
     let binary = Bvh::build(&boxes(shapes));
     let mut hits = 0;
     for (k, ray) in rays.iter().enumerate() {
@@ -119,9 +135,11 @@ fn check_scene(name: &str, shapes: &[Shape], rays: &[Ray], rng: &mut Pcg32) -> u
         };
         let brute = brute_force(shapes, ray, t_max);
         let old = binary.intersect(ray, t_max, |i, t| test_shape(&shapes[i as usize], ray, t));
-        let scalar = accels[0].intersect(ray, t_max, accept_all);
-        for accel in &accels {
-            let simd = accel.simd();
+        for accel in accels.iter().flatten() {
+            // Within a layout every kernel walks the same order: the same hit, bit for bit.
+            let scalar = accels[(accel.layout() == NodeLayout::Quantized) as usize][0]
+                .intersect(ray, t_max, accept_all);
+            let simd = (accel.layout(), accel.simd());
             let new = accel.intersect(ray, t_max, accept_all);
             assert_eq!(
                 new.map(|h| (h.prim, h.t.to_bits(), h.b1.to_bits(), h.b2.to_bits())),
@@ -161,6 +179,14 @@ fn check_scene(name: &str, shapes: &[Shape], rays: &[Ray], rng: &mut Pcg32) -> u
         hits += brute.is_some() as usize;
     }
     hits
+}
+
+/// Every kernel set the CPU has, with each node layout.
+fn kernels_and_layouts() -> Vec<(Simd, NodeLayout)> {
+    Simd::available()
+        .into_iter()
+        .flat_map(|s| [(s, NodeLayout::Full), (s, NodeLayout::Quantized)])
+        .collect()
 }
 
 fn random_soup(rng: &mut Pcg32, n: usize, spheres: usize) -> Vec<Shape> {
@@ -304,8 +330,8 @@ fn rays_inside_box_planes_and_non_finite_rays() {
     }
     let mut rng = Pcg32::new(5, 5);
     check_scene("cube planes", &cube, &rays, &mut rng);
-    for simd in Simd::available() {
-        let accel = Accel::build_for(&cube, |_| false, simd);
+    for (simd, layout) in kernels_and_layouts() {
+        let accel = Accel::build_layout(&cube, |_| false, simd, layout);
         for bad in [
             Ray::new(Vec3::splat(f32::NAN), Vec3::X),
             Ray::new(Vec3::splat(0.5), Vec3::splat(f32::NAN)),
@@ -325,9 +351,9 @@ fn rejected_hits_are_as_if_the_triangles_were_not_there() {
     let kept: Vec<u32> = (0..shapes.len() as u32).filter(|&i| !masked(i)).collect();
     let kept_shapes: Vec<Shape> = kept.iter().map(|&i| shapes[i as usize]).collect();
     let rays = random_rays(&mut rng, &shapes, bounds_of(&shapes), 8000);
-    for simd in Simd::available() {
-        let with_filter = Accel::build_for(&shapes, masked, simd);
-        let without = Accel::build_for(&kept_shapes, |_| false, simd);
+    for (simd, layout) in kernels_and_layouts() {
+        let with_filter = Accel::build_layout(&shapes, masked, simd, layout);
+        let without = Accel::build_layout(&kept_shapes, |_| false, simd, layout);
         let calls = std::cell::Cell::new(0usize);
         let reject_odd = |i: u32, _: &_| {
             calls.set(calls.get() + 1);
@@ -342,23 +368,23 @@ fn rejected_hits_are_as_if_the_triangles_were_not_there() {
             assert_eq!(
                 a.map(|h| (h.prim, h.t.to_bits())),
                 b.map(|h| (kept[h.prim as usize], h.t.to_bits())),
-                "{simd:?} ray {k}"
+                "{simd:?} {layout:?} ray {k}"
             );
             assert_eq!(
                 with_filter.occluded(ray, t_max, reject_odd),
                 b.is_some(),
-                "{simd:?} ray {k}"
+                "{simd:?} {layout:?} ray {k}"
             );
             hits += b.is_some() as usize;
         }
-        assert!(hits > 1000, "{simd:?}: only {hits} hits");
+        assert!(hits > 1000, "{simd:?} {layout:?}: only {hits} hits");
         assert!(
             calls.get() > 1000,
-            "{simd:?}: filter called only {} times",
+            "{simd:?} {layout:?}: filter called only {} times",
             calls.get()
         );
         // Accepting everything is the same as no flags at all.
-        let plain = Accel::build_for(&shapes, |_| false, simd);
+        let plain = Accel::build_layout(&shapes, |_| false, simd, layout);
         for ray in &rays {
             assert_eq!(
                 with_filter.intersect(ray, f32::INFINITY, accept_all),
@@ -370,7 +396,7 @@ fn rejected_hits_are_as_if_the_triangles_were_not_there() {
             );
         }
         eprintln!(
-            "{simd:?}: {} rays, {hits} hit, filter called {} times",
+            "{simd:?} {layout:?}: {} rays, {hits} hit, filter called {} times",
             rays.len(),
             calls.get()
         );

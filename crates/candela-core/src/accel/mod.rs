@@ -14,6 +14,9 @@
 //! The SIMD kernels ([`Simd`]) are chosen once, at build: AVX2 box and triangle tests
 //! where the CPU has them, else SSE; [`Accel::build_for`] forces one (the tests run each the CPU has
 //! against the scalar one). Every kernel finds the same hits, bit for bit.
+//!
+//! [`NodeLayout`] picks the wide nodes: full planes (the default) or quantized boxes
+//! (half the node memory; [`Accel::build_layout`]).
 
 mod block;
 mod lanes;
@@ -22,7 +25,7 @@ use glam::Vec3;
 
 #[cfg(target_arch = "x86_64")]
 use crate::bvh::{Avx2Boxes, SseBoxes};
-use crate::bvh::{BoxTest, Bvh, SahCost, ScalarBoxes, WideBvh};
+use crate::bvh::{BoxTest, Bvh, Node8, QNode8, SahCost, ScalarBoxes, WideBvh, WideNode};
 use crate::geometry::{Aabb, Ray, TriangleHit, WatertightRay};
 use block::{Block, FILTERED, ID_MASK, LANES, SPHERE};
 
@@ -65,9 +68,33 @@ pub fn accept_all(_: u32, _: &TriangleHit) -> bool {
     true
 }
 
+/// How the wide BVH's nodes store their child boxes. Both find the same hits (the
+/// quantized boxes contain the exact ones, and the primitive tests decide).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum NodeLayout {
+    /// Full f32 planes ([`Node8`], 256 bytes a node): the default, the faster one
+    /// measured (bench/README.md, "Compressed nodes").
+    #[default]
+    Full,
+    /// Child boxes in bytes against a per-node frame ([`QNode8`], 128 bytes a node).
+    Quantized,
+}
+
+#[derive(Clone, Debug)]
+enum Tree {
+    Full(WideBvh<Node8>),
+    Quantized(WideBvh<QNode8>),
+}
+
+impl Default for Tree {
+    fn default() -> Self {
+        Tree::Full(WideBvh::default())
+    }
+}
+
 #[derive(Clone, Debug, Default)]
 pub struct Accel {
-    bvh: WideBvh,
+    tree: Tree,
     blocks: Vec<Block>,
     simd: Simd,
 }
@@ -82,6 +109,16 @@ impl Accel {
     /// [`Accel::build`] with the given kernels, which must be supported by this CPU
     /// ([`Simd::available`]); for tests and benchmarks.
     pub fn build_for(shapes: &[Shape], filtered: impl Fn(u32) -> bool, simd: Simd) -> Accel {
+        Accel::build_layout(shapes, filtered, simd, NodeLayout::Full)
+    }
+
+    /// [`Accel::build_for`] with the given node layout.
+    pub fn build_layout(
+        shapes: &[Shape],
+        filtered: impl Fn(u32) -> bool,
+        simd: Simd,
+        layout: NodeLayout,
+    ) -> Accel {
         assert!(
             simd.is_supported(),
             "{simd:?} kernels on a CPU without them"
@@ -118,11 +155,34 @@ impl Accel {
                 }
             }
         }
-        Accel { bvh, blocks, simd }
+        let tree = match layout {
+            NodeLayout::Full => Tree::Full(bvh),
+            NodeLayout::Quantized => Tree::Quantized(bvh.quantize()),
+        };
+        Accel { tree, blocks, simd }
     }
 
     pub fn bounds(&self) -> Aabb {
-        self.bvh.bounds()
+        match &self.tree {
+            Tree::Full(t) => t.bounds(),
+            Tree::Quantized(t) => t.bounds(),
+        }
+    }
+
+    pub fn layout(&self) -> NodeLayout {
+        match self.tree {
+            Tree::Full(_) => NodeLayout::Full,
+            Tree::Quantized(_) => NodeLayout::Quantized,
+        }
+    }
+
+    /// Bytes of the wide BVH's nodes and of the primitive blocks.
+    pub fn memory(&self) -> (usize, usize) {
+        let nodes = match &self.tree {
+            Tree::Full(t) => size_of_val(&t.nodes[..]),
+            Tree::Quantized(t) => size_of_val(&t.nodes[..]),
+        };
+        (nodes, size_of_val(&self.blocks[..]))
     }
 
     /// The kernels this structure traces with.
@@ -205,9 +265,25 @@ impl Accel {
         t_max: f32,
         filter: &impl Fn(u32, &TriangleHit) -> bool,
     ) -> Option<Hit> {
+        match &self.tree {
+            Tree::Full(t) => self.intersect_tree::<K, LEAF, _>(t, ray, t_max, filter),
+            Tree::Quantized(t) => self.intersect_tree::<K, LEAF, _>(t, ray, t_max, filter),
+        }
+    }
+
+    /// # Safety
+    /// The CPU must support `K` and `LEAF`.
+    #[inline(always)]
+    unsafe fn intersect_tree<K: BoxTest, const LEAF: u8, N: WideNode>(
+        &self,
+        tree: &WideBvh<N>,
+        ray: &Ray,
+        t_max: f32,
+        filter: &impl Fn(u32, &TriangleHit) -> bool,
+    ) -> Option<Hit> {
         let wray = WatertightRay::new(ray);
         let mut best: Option<Hit> = None;
-        self.bvh.intersect::<K>(
+        tree.intersect::<K>(
             ray,
             t_max,
             #[inline(always)]
@@ -244,8 +320,24 @@ impl Accel {
         t_max: f32,
         filter: &impl Fn(u32, &TriangleHit) -> bool,
     ) -> bool {
+        match &self.tree {
+            Tree::Full(t) => self.occluded_tree::<K, LEAF, _>(t, ray, t_max, filter),
+            Tree::Quantized(t) => self.occluded_tree::<K, LEAF, _>(t, ray, t_max, filter),
+        }
+    }
+
+    /// # Safety
+    /// The CPU must support `K` and `LEAF`.
+    #[inline(always)]
+    unsafe fn occluded_tree<K: BoxTest, const LEAF: u8, N: WideNode>(
+        &self,
+        tree: &WideBvh<N>,
+        ray: &Ray,
+        t_max: f32,
+        filter: &impl Fn(u32, &TriangleHit) -> bool,
+    ) -> bool {
         let wray = WatertightRay::new(ray);
-        self.bvh.occluded::<K>(
+        tree.occluded::<K>(
             ray,
             t_max,
             #[inline(always)]

@@ -7,6 +7,7 @@
 
 use glam::Vec3;
 
+use super::quant8::QBoxes8;
 use crate::geometry::{gamma, Ray};
 
 /// Eight boxes, planes as `[min_x, max_x, min_y, max_y, min_z, max_z]`, eight lanes each.
@@ -113,6 +114,13 @@ pub trait BoxTest {
     /// # Safety
     /// As for [`BoxTest::prepare`].
     unsafe fn hit8(ray: &Self::Prepared, planes: &Planes8, t_max: f32) -> (u32, [f32; 8]);
+
+    /// [`BoxTest::hit8`] on quantized boxes, dequantized in the kernel: the same bits
+    /// as `hit8` on [`QBoxes8::planes`].
+    ///
+    /// # Safety
+    /// As for [`BoxTest::prepare`].
+    unsafe fn hit8q(ray: &Self::Prepared, boxes: &QBoxes8, t_max: f32) -> (u32, [f32; 8]);
 }
 
 /// `maxps` semantics: the second operand when either is NaN.
@@ -150,6 +158,11 @@ impl BoxTest for ScalarBoxes {
     unsafe fn hit8(ray: &Ray8, planes: &Planes8, t_max: f32) -> (u32, [f32; 8]) {
         hit8_scalar(ray, planes, t_max)
     }
+
+    #[inline(always)]
+    unsafe fn hit8q(ray: &Ray8, boxes: &QBoxes8, t_max: f32) -> (u32, [f32; 8]) {
+        hit8_scalar(ray, &boxes.planes(), t_max)
+    }
 }
 
 /// [`ScalarBoxes`]' test as a safe function, for tests.
@@ -182,7 +195,7 @@ pub use x86::{Avx2Boxes, SseBoxes};
 mod x86 {
     use std::arch::x86_64::*;
 
-    use super::{BoxTest, Planes8, Ray8};
+    use super::{BoxTest, Planes8, QBoxes8, Ray8};
 
     /// Two 4-lane SSE halves.
     pub struct SseBoxes;
@@ -212,27 +225,54 @@ mod x86 {
 
         #[inline(always)]
         unsafe fn hit8(r: &SseRay, planes: &Planes8, t_max: f32) -> (u32, [f32; 8]) {
-            let mut out = [0.0f32; 8];
-            let mut mask = 0;
-            for half in 0..2 {
-                let mut t_near = _mm_setzero_ps();
-                let mut t_far = _mm_set1_ps(t_max);
-                for axis in 0..3 {
-                    let n = r.near[axis];
-                    let near = _mm_loadu_ps(planes.get_unchecked(n).as_ptr().add(4 * half));
-                    let far = _mm_loadu_ps(planes.get_unchecked(n ^ 1).as_ptr().add(4 * half));
-                    t_near =
-                        _mm_max_ps(_mm_mul_ps(_mm_sub_ps(near, r.o[axis]), r.inv[axis]), t_near);
-                    t_far = _mm_min_ps(
-                        _mm_mul_ps(_mm_sub_ps(far, r.o[axis]), r.inv_far[axis]),
-                        t_far,
-                    );
-                }
-                mask |= (_mm_movemask_ps(_mm_cmple_ps(t_near, t_far)) as u32) << (4 * half);
-                _mm_storeu_ps(out.as_mut_ptr().add(4 * half), t_near);
-            }
-            (mask, out)
+            slab_sse(r, t_max, |_, row, half| {
+                _mm_loadu_ps(planes.get_unchecked(row).as_ptr().add(4 * half))
+            })
         }
+
+        #[inline(always)]
+        unsafe fn hit8q(r: &SseRay, boxes: &QBoxes8, t_max: f32) -> (u32, [f32; 8]) {
+            slab_sse(r, t_max, |axis, row, half| {
+                // Four bytes to four floats with SSE2 only: widen with zeros twice, convert.
+                let bytes = boxes.q.get_unchecked(row).as_ptr().add(4 * half);
+                let v = _mm_cvtsi32_si128((bytes as *const i32).read_unaligned());
+                let zero = _mm_setzero_si128();
+                let q = _mm_cvtepi32_ps(_mm_unpacklo_epi16(_mm_unpacklo_epi8(v, zero), zero));
+                let step = _mm_set1_ps(*boxes.step.get_unchecked(axis));
+                _mm_add_ps(
+                    _mm_mul_ps(q, step),
+                    _mm_set1_ps(*boxes.origin.get_unchecked(axis)),
+                )
+            })
+        }
+    }
+
+    /// The slab test in two halves; `plane(axis, row, half)` gives four lanes of plane
+    /// row `row` (of [`Planes8`]'s order).
+    #[inline(always)]
+    unsafe fn slab_sse(
+        r: &SseRay,
+        t_max: f32,
+        plane: impl Fn(usize, usize, usize) -> __m128,
+    ) -> (u32, [f32; 8]) {
+        let mut out = [0.0f32; 8];
+        let mut mask = 0;
+        for half in 0..2 {
+            let mut t_near = _mm_setzero_ps();
+            let mut t_far = _mm_set1_ps(t_max);
+            for axis in 0..3 {
+                let n = r.near[axis];
+                let (near, far) = (plane(axis, n, half), plane(axis, n ^ 1, half));
+                t_near = _mm_max_ps(_mm_mul_ps(_mm_sub_ps(near, r.o[axis]), r.inv[axis]), t_near);
+                t_far = _mm_min_ps(
+                    _mm_mul_ps(_mm_sub_ps(far, r.o[axis]), r.inv_far[axis]),
+                    t_far,
+                );
+            }
+            mask |= (_mm_movemask_ps(_mm_cmple_ps(t_near, t_far)) as u32) << (4 * half);
+            _mm_storeu_ps(out.as_mut_ptr().add(4 * half), t_near);
+        }
+        (mask, out)
     }
 
     /// One 8-lane AVX2 register.
@@ -264,26 +304,53 @@ mod x86 {
         #[inline]
         #[target_feature(enable = "avx2")]
         unsafe fn hit8(r: &Avx2Ray, planes: &Planes8, t_max: f32) -> (u32, [f32; 8]) {
-            let mut t_near = _mm256_setzero_ps();
-            let mut t_far = _mm256_set1_ps(t_max);
-            for axis in 0..3 {
-                let n = r.near[axis];
-                let near = _mm256_loadu_ps(planes.get_unchecked(n).as_ptr());
-                let far = _mm256_loadu_ps(planes.get_unchecked(n ^ 1).as_ptr());
-                t_near = _mm256_max_ps(
-                    _mm256_mul_ps(_mm256_sub_ps(near, r.o[axis]), r.inv[axis]),
-                    t_near,
-                );
-                t_far = _mm256_min_ps(
-                    _mm256_mul_ps(_mm256_sub_ps(far, r.o[axis]), r.inv_far[axis]),
-                    t_far,
-                );
-            }
-            let mask = _mm256_movemask_ps(_mm256_cmp_ps::<_CMP_LE_OQ>(t_near, t_far)) as u32;
-            let mut out = [0.0f32; 8];
-            _mm256_storeu_ps(out.as_mut_ptr(), t_near);
-            (mask, out)
+            slab_avx2(r, t_max, |_, row| {
+                _mm256_loadu_ps(planes.get_unchecked(row).as_ptr())
+            })
         }
+
+        #[inline]
+        #[target_feature(enable = "avx2")]
+        unsafe fn hit8q(r: &Avx2Ray, boxes: &QBoxes8, t_max: f32) -> (u32, [f32; 8]) {
+            slab_avx2(r, t_max, |axis, row| {
+                let bytes = boxes.q.get_unchecked(row).as_ptr() as *const __m128i;
+                let q = _mm256_cvtepi32_ps(_mm256_cvtepu8_epi32(_mm_loadl_epi64(bytes)));
+                // Multiply, then add: not fused, so as the scalar kernel rounds.
+                let step = _mm256_set1_ps(*boxes.step.get_unchecked(axis));
+                _mm256_add_ps(
+                    _mm256_mul_ps(q, step),
+                    _mm256_set1_ps(*boxes.origin.get_unchecked(axis)),
+                )
+            })
+        }
+    }
+
+    /// The slab test; `plane(axis, row)` gives plane row `row` (of [`Planes8`]'s order).
+    #[inline]
+    #[target_feature(enable = "avx2")]
+    unsafe fn slab_avx2(
+        r: &Avx2Ray,
+        t_max: f32,
+        plane: impl Fn(usize, usize) -> __m256,
+    ) -> (u32, [f32; 8]) {
+        let mut t_near = _mm256_setzero_ps();
+        let mut t_far = _mm256_set1_ps(t_max);
+        for axis in 0..3 {
+            let n = r.near[axis];
+            let (near, far) = (plane(axis, n), plane(axis, n ^ 1));
+            t_near = _mm256_max_ps(
+                _mm256_mul_ps(_mm256_sub_ps(near, r.o[axis]), r.inv[axis]),
+                t_near,
+            );
+            t_far = _mm256_min_ps(
+                _mm256_mul_ps(_mm256_sub_ps(far, r.o[axis]), r.inv_far[axis]),
+                t_far,
+            );
+        }
+        let mask = _mm256_movemask_ps(_mm256_cmp_ps::<_CMP_LE_OQ>(t_near, t_far)) as u32;
+        let mut out = [0.0f32; 8];
+        _mm256_storeu_ps(out.as_mut_ptr(), t_near);
+        (mask, out)
     }
 }
 
@@ -293,7 +360,9 @@ mod tests {
     use crate::sampler::Pcg32;
 
     /// Every kernel the CPU has gives the scalar kernel's mask and entry bits on random
-    /// boxes, empty slots, flat boxes and rays lying in box planes.
+    /// boxes, empty slots, flat boxes and rays lying in box planes, with full planes and
+    /// with quantized ones; the quantized boxes are hit wherever the exact ones are, and
+    /// entered no later.
     #[test]
     #[allow(clippy::needless_range_loop)] // lanes index two arrays at once
     fn kernels_agree_bit_for_bit() {
@@ -335,17 +404,56 @@ mod tests {
             let ray = Ray8::new(&Ray::new(o, d));
             let t_max = if k % 2 == 0 { f32::INFINITY } else { u() * 3.0 };
             let (m0, t0) = hit8_scalar(&ray, &planes, t_max);
+            // The same boxes quantized: the kernels dequantize to `qplanes`' bits, and
+            // the quantized boxes are entered wherever the exact ones are.
+            let used = (0..8)
+                .filter(|&l| (k + l) % 5 != 0)
+                .fold(0u8, |m, l| m | 1 << l);
+            let bounds = (0..8)
+                .filter(|&l| used & (1 << l) != 0)
+                .map(|l| crate::geometry::Aabb {
+                    min: Vec3::new(planes[0][l], planes[2][l], planes[4][l]),
+                    max: Vec3::new(planes[1][l], planes[3][l], planes[5][l]),
+                })
+                .fold(crate::geometry::Aabb::EMPTY, crate::geometry::Aabb::union);
+            let quantized = QBoxes8::new(&planes, bounds, used);
+            let qplanes = quantized.planes();
+            let (qm0, qt0) = hit8_scalar(&ray, &qplanes, t_max);
+            assert_eq!(
+                m0 & !qm0 & used as u32,
+                0,
+                "case {k}: a quantized box missed where the exact one is hit"
+            );
+            for lane in (0..8).filter(|&l| m0 & (1 << l) != 0) {
+                assert!(qt0[lane] <= t0[lane], "case {k}: entered later");
+            }
             for &simd in &simds {
                 // SAFETY: `simds` holds only kernels this CPU supports.
-                let (m, t) = unsafe {
+                let ((m, t), (qm, qt)) = unsafe {
                     match simd {
                         Simd::Scalar => {
-                            ScalarBoxes::hit8(&ScalarBoxes::prepare(&ray), &planes, t_max)
+                            let r = ScalarBoxes::prepare(&ray);
+                            (
+                                ScalarBoxes::hit8(&r, &planes, t_max),
+                                ScalarBoxes::hit8q(&r, &quantized, t_max),
+                            )
                         }
                         #[cfg(target_arch = "x86_64")]
-                        Simd::Sse => SseBoxes::hit8(&SseBoxes::prepare(&ray), &planes, t_max),
+                        Simd::Sse => {
+                            let r = SseBoxes::prepare(&ray);
+                            (
+                                SseBoxes::hit8(&r, &planes, t_max),
+                                SseBoxes::hit8q(&r, &quantized, t_max),
+                            )
+                        }
                         #[cfg(target_arch = "x86_64")]
-                        Simd::Avx2 => Avx2Boxes::hit8(&Avx2Boxes::prepare(&ray), &planes, t_max),
+                        Simd::Avx2 => {
+                            let r = Avx2Boxes::prepare(&ray);
+                            (
+                                Avx2Boxes::hit8(&r, &planes, t_max),
+                                Avx2Boxes::hit8q(&r, &quantized, t_max),
+                            )
+                        }
                         #[cfg(not(target_arch = "x86_64"))]
                         _ => unreachable!(),
                     }
@@ -355,6 +463,12 @@ mod tests {
                     t.map(f32::to_bits),
                     t0.map(f32::to_bits),
                     "{simd:?} case {k}"
+                );
+                assert_eq!(qm, qm0, "{simd:?} quantized, case {k}");
+                assert_eq!(
+                    qt.map(f32::to_bits),
+                    qt0.map(f32::to_bits),
+                    "{simd:?} quantized, case {k}"
                 );
             }
             // The slab test agrees with `Aabb::hit` on which boxes the ray meets.

@@ -9,6 +9,7 @@ use std::mem::MaybeUninit;
 
 use super::binary::{Bvh, BvhNode};
 use super::box8::{BoxTest, Planes8, Ray8, T_MAX_SCALE};
+use super::quant8::QBoxes8;
 use crate::geometry::{Aabb, Ray};
 
 const WIDTH: usize = 8;
@@ -58,12 +59,102 @@ impl Node8 {
     }
 }
 
+/// What the traversal asks of a node: which children a ray enters, and the links.
+pub trait WideNode: Copy {
+    /// The box test of the eight children (bit `i` for child `i`, entry distances).
+    ///
+    /// # Safety
+    /// The CPU must support kernel `K`.
+    unsafe fn hit<K: BoxTest>(&self, ray: &K::Prepared, t_max: f32) -> (u32, [f32; 8]);
+    /// `child`, `count` and `leaves`, as in [`Node8`].
+    fn links(&self) -> (&[u32; WIDTH], &[u8; WIDTH], u8);
+}
+
+impl WideNode for Node8 {
+    #[inline(always)]
+    unsafe fn hit<K: BoxTest>(&self, ray: &K::Prepared, t_max: f32) -> (u32, [f32; 8]) {
+        K::hit8(ray, &self.planes, t_max)
+    }
+    #[inline(always)]
+    fn links(&self) -> (&[u32; WIDTH], &[u8; WIDTH], u8) {
+        (&self.child, &self.count, self.leaves)
+    }
+}
+
+/// [`Node8`] with its child boxes quantized to bytes ([`QBoxes8`]): 114 bytes, two
+/// cache lines instead of four. `used` has bit `i` set for each child slot in use; the
+/// others' bytes mean nothing and their hits are masked off.
+#[derive(Clone, Copy, Debug)]
+#[repr(C, align(64))]
+pub struct QNode8 {
+    pub boxes: QBoxes8,
+    pub child: [u32; WIDTH],
+    pub count: [u8; WIDTH],
+    pub leaves: u8,
+    pub used: u8,
+}
+
+const _: () = assert!(size_of::<QNode8>() == 128);
+
+impl QNode8 {
+    /// Quantizes `node`'s boxes (each dequantized box contains the exact one).
+    pub fn new(node: &Node8) -> QNode8 {
+        let used = (0..WIDTH)
+            .filter(|&l| !node.child_bounds(l).is_empty())
+            .fold(0u8, |m, l| m | 1 << l);
+        let bounds = (0..WIDTH)
+            .map(|l| node.child_bounds(l))
+            .fold(Aabb::EMPTY, Aabb::union);
+        QNode8 {
+            boxes: QBoxes8::new(&node.planes, bounds, used),
+            child: node.child,
+            count: node.count,
+            leaves: node.leaves,
+            used,
+        }
+    }
+
+    /// The dequantized box of child `lane` (empty for an unused slot).
+    pub fn child_bounds(&self, lane: usize) -> Aabb {
+        if self.used & (1 << lane) == 0 {
+            return Aabb::EMPTY;
+        }
+        let p = self.boxes.planes();
+        Aabb {
+            min: glam::Vec3::new(p[0][lane], p[2][lane], p[4][lane]),
+            max: glam::Vec3::new(p[1][lane], p[3][lane], p[5][lane]),
+        }
+    }
+}
+
+impl WideNode for QNode8 {
+    #[inline(always)]
+    unsafe fn hit<K: BoxTest>(&self, ray: &K::Prepared, t_max: f32) -> (u32, [f32; 8]) {
+        let (mask, t) = K::hit8q(ray, &self.boxes, t_max);
+        (mask & self.used as u32, t)
+    }
+    #[inline(always)]
+    fn links(&self) -> (&[u32; WIDTH], &[u8; WIDTH], u8) {
+        (&self.child, &self.count, self.leaves)
+    }
+}
+
 /// An eight-wide BVH; node 0 is the root. Leaves index the same leaf order as the
-/// binary tree it was made from.
-#[derive(Clone, Debug, Default)]
-pub struct WideBvh {
-    pub nodes: Vec<Node8>,
+/// binary tree it was made from. Nodes are [`Node8`] as collapsed, or [`QNode8`] after
+/// [`WideBvh::quantize`].
+#[derive(Clone, Debug)]
+pub struct WideBvh<N = Node8> {
+    pub nodes: Vec<N>,
     bounds: Aabb,
+}
+
+impl<N> Default for WideBvh<N> {
+    fn default() -> Self {
+        WideBvh {
+            nodes: Vec::new(),
+            bounds: Aabb::EMPTY,
+        }
+    }
 }
 
 /// One pending subtree: a node or a leaf, and where the ray enters its box.
@@ -93,7 +184,7 @@ pub fn prefetch(p: *const u8, lines: usize) {
     let _ = (p, lines);
 }
 
-impl WideBvh {
+impl WideBvh<Node8> {
     /// Collapses a binary tree: each wide node takes the binary node's two children and
     /// keeps opening its largest interior child (by surface area) until it has eight,
     /// which keeps the SAH tree's cuts. (Opening first the subtrees whose leaves all fit
@@ -178,6 +269,16 @@ impl WideBvh {
         }
     }
 
+    /// The same tree with quantized child boxes, node for node.
+    pub fn quantize(&self) -> WideBvh<QNode8> {
+        WideBvh {
+            nodes: self.nodes.iter().map(QNode8::new).collect(),
+            bounds: self.bounds,
+        }
+    }
+}
+
+impl<N: WideNode> WideBvh<N> {
     pub fn bounds(&self) -> Aabb {
         self.bounds
     }
@@ -202,6 +303,7 @@ impl WideBvh {
         if self.nodes.is_empty() || !(ray.o.is_finite() && ray.d.is_finite()) {
             return;
         }
+        let node_lines = size_of::<N>() / 64;
         let r = K::prepare(&Ray8::new(ray));
         // Left uninitialised: zeroing it would cost as much as a shallow traversal.
         let mut stack = [const { MaybeUninit::<Entry>::uninit() }; STACK];
@@ -209,17 +311,18 @@ impl WideBvh {
         let mut current = 0usize;
         loop {
             let node = &self.nodes[current];
-            let (mut mask, t_near) = K::hit8(&r, &node.planes, t_max * T_MAX_SCALE);
+            let (mut mask, t_near) = node.hit::<K>(&r, t_max * T_MAX_SCALE);
+            let (child, count, _) = node.links();
             if mask & mask.wrapping_sub(1) == 0 {
                 // One child or none: no sorting, and an interior child is next.
                 if mask != 0 {
                     let lane = mask.trailing_zeros() as usize;
-                    let count = node.count[lane] as u32;
-                    if count == 0 {
-                        current = node.child[lane] as usize;
+                    let prims = count[lane] as u32;
+                    if prims == 0 {
+                        current = child[lane] as usize;
                         continue;
                     }
-                    t_max = leaf(node.child[lane], count, t_max);
+                    t_max = leaf(child[lane], prims, t_max);
                 }
             } else {
                 // Push the hit children farthest first so that the nearest is popped next.
@@ -228,8 +331,8 @@ impl WideBvh {
                     let lane = mask.trailing_zeros() as usize;
                     mask &= mask - 1;
                     let entry = Entry {
-                        child: node.child[lane],
-                        count: node.count[lane] as u32,
+                        child: child[lane],
+                        count: count[lane] as u32,
                         t: t_near[lane],
                     };
                     // It waits on the stack: have its memory on the way meanwhile
@@ -237,7 +340,7 @@ impl WideBvh {
                     if entry.count == 0 {
                         prefetch(
                             self.nodes.as_ptr().wrapping_add(entry.child as usize) as *const u8,
-                            4,
+                            node_lines,
                         );
                     } else {
                         prefetch_leaf(entry.child);
@@ -290,6 +393,7 @@ impl WideBvh {
         if self.nodes.is_empty() || !(ray.o.is_finite() && ray.d.is_finite()) {
             return false;
         }
+        let node_lines = size_of::<N>() / 64;
         let r = K::prepare(&Ray8::new(ray));
         let t_box = t_max * T_MAX_SCALE;
         let mut stack = [const { MaybeUninit::<u32>::uninit() }; STACK];
@@ -297,27 +401,28 @@ impl WideBvh {
         let mut current = 0usize;
         loop {
             let node = &self.nodes[current];
-            let (mask, _) = K::hit8(&r, &node.planes, t_box);
-            let leaves = node.leaves as u32;
+            let (mask, _) = node.hit::<K>(&r, t_box);
+            let (child, count, leaves) = node.links();
+            let leaves = leaves as u32;
             let mut hit_leaves = mask & leaves;
             while hit_leaves != 0 {
                 let lane = hit_leaves.trailing_zeros() as usize;
                 hit_leaves &= hit_leaves - 1;
-                if leaf(node.child[lane], node.count[lane] as u32, t_max) {
+                if leaf(child[lane], count[lane] as u32, t_max) {
                     return true;
                 }
             }
             let mut inner = mask & !leaves;
             if inner != 0 {
-                current = node.child[inner.trailing_zeros() as usize] as usize;
+                current = child[inner.trailing_zeros() as usize] as usize;
                 inner &= inner - 1;
                 while inner != 0 {
-                    let child = node.child[inner.trailing_zeros() as usize];
+                    let next = child[inner.trailing_zeros() as usize];
                     prefetch(
-                        self.nodes.as_ptr().wrapping_add(child as usize) as *const u8,
-                        4,
+                        self.nodes.as_ptr().wrapping_add(next as usize) as *const u8,
+                        node_lines,
                     );
-                    stack[sp].write(child);
+                    stack[sp].write(next);
                     sp += 1;
                     inner &= inner - 1;
                 }
@@ -391,6 +496,151 @@ mod tests {
         }
         assert_eq!(visited, wide.nodes.len(), "every node is reached once");
         assert!(seen.iter().all(|&c| c == 1));
+    }
+
+    /// The quantized tree finds what the full one finds, on boxes as primitives (hit at
+    /// their entry distance by the slab test): the same nearest distance, bit for bit, as
+    /// brute force, and the same any-hit answers, with every kernel. Rays start inside
+    /// boxes, on their planes and outside, some along axes or with ±0 components, some
+    /// with a finite t_max. Each quantized child box also contains its exact box.
+    #[test]
+    fn quantized_nodes_find_the_same_hits() {
+        let mut rng = Pcg32::new(8, 21);
+        let mut u = || rng.uniform_f32();
+        let boxes: Vec<Aabb> = (0..2000)
+            .map(|k| {
+                let c = Vec3::new(u(), u(), u()) * 10.0;
+                let mut e = Vec3::new(u(), u(), u()) * 0.4;
+                if k % 9 == 0 {
+                    e.z = 0.0; // flat
+                }
+                Aabb { min: c, max: c + e }
+            })
+            .collect();
+        let binary = Bvh::build(&boxes);
+        let full = WideBvh::collapse(&binary);
+        let quantized = full.quantize();
+        for (f, q) in full.nodes.iter().zip(&quantized.nodes) {
+            for lane in 0..WIDTH {
+                let (a, b) = (f.child_bounds(lane), q.child_bounds(lane));
+                assert!(a.is_empty() || a.union(b) == b, "{a:?} not inside {b:?}");
+            }
+        }
+        let leaf_order: Vec<Aabb> = binary.prims.iter().map(|&p| boxes[p as usize]).collect();
+        let mut hits = 0;
+        for k in 0..20000 {
+            let target = boxes[k % boxes.len()];
+            let o = match k % 4 {
+                0 => (target.min + target.max) * 0.5,
+                1 => target.min,
+                2 => Vec3::new(u(), u(), u()) * 14.0 - 2.0,
+                _ => Vec3::new(target.min.x, u() * 10.0, target.max.z),
+            };
+            let mut d = Vec3::new(u(), u(), u()) - 0.5;
+            match k % 5 {
+                0 => d = [Vec3::X, -Vec3::Y, Vec3::Z][k / 5 % 3],
+                1 => d.x = -0.0,
+                2 => d.y = 0.0,
+                _ => {}
+            }
+            let ray = Ray::new(o, d.normalize_or(Vec3::Y));
+            let t_max = if k % 3 == 0 { u() * 3.0 } else { f32::INFINITY };
+            let brute = boxes
+                .iter()
+                .filter_map(|b| box_prim(b, &ray, t_max))
+                .min_by(f32::total_cmp);
+            hits += brute.is_some() as usize;
+            for simd in crate::bvh::Simd::available() {
+                let args = (&ray, t_max, &leaf_order[..]);
+                // SAFETY: `available` lists only kernels this CPU supports.
+                let found = unsafe {
+                    match simd {
+                        #[cfg(target_arch = "x86_64")]
+                        crate::bvh::Simd::Sse => {
+                            use super::super::box8::SseBoxes as K;
+                            [
+                                box_queries::<K, _>(&full, args),
+                                box_queries::<K, _>(&quantized, args),
+                            ]
+                        }
+                        #[cfg(target_arch = "x86_64")]
+                        crate::bvh::Simd::Avx2 => {
+                            use super::super::box8::Avx2Boxes as K;
+                            [
+                                box_queries::<K, _>(&full, args),
+                                box_queries::<K, _>(&quantized, args),
+                            ]
+                        }
+                        _ => {
+                            use super::super::box8::ScalarBoxes as K;
+                            [
+                                box_queries::<K, _>(&full, args),
+                                box_queries::<K, _>(&quantized, args),
+                            ]
+                        }
+                    }
+                };
+                for (layout, (t, blocked)) in ["full", "quantized"].iter().zip(found) {
+                    assert_eq!(
+                        t.map(f32::to_bits),
+                        brute.map(f32::to_bits),
+                        "{simd:?} {layout}: ray {k} {ray:?}"
+                    );
+                    assert_eq!(
+                        blocked,
+                        brute.is_some(),
+                        "{simd:?} {layout}: any-hit, ray {k}"
+                    );
+                }
+            }
+        }
+        assert!(hits > 5000, "only {hits} rays hit");
+    }
+
+    /// A box as a primitive: hit at the scalar slab test's entry distance. (Not
+    /// `Aabb::hit`: where a plane's distance is NaN its result depends on glam's
+    /// `min_element` order, so it can report a hit the slab test rightly rejects.)
+    fn box_prim(b: &Aabb, ray: &Ray, t_max: f32) -> Option<f32> {
+        let mut planes = Node8::UNUSED.planes;
+        for axis in 0..3 {
+            planes[2 * axis][0] = b.min[axis];
+            planes[2 * axis + 1][0] = b.max[axis];
+        }
+        let (mask, t) = super::super::box8::hit8_scalar(&Ray8::new(ray), &planes, t_max);
+        (mask & 1 != 0).then_some(t[0])
+    }
+
+    /// Nearest-hit distance and any-hit answer of `bvh` on boxes as primitives (given in
+    /// leaf order, hit as [`box_prim`] says).
+    ///
+    /// # Safety
+    /// The CPU must support `K`.
+    unsafe fn box_queries<K: BoxTest, N: WideNode>(
+        bvh: &WideBvh<N>,
+        (ray, t_max, leaf_order): (&Ray, f32, &[Aabb]),
+    ) -> (Option<f32>, bool) {
+        let prims = |first: u32, count: u32| &leaf_order[first as usize..(first + count) as usize];
+        let mut best = None;
+        bvh.intersect::<K>(
+            ray,
+            t_max,
+            |first, count, mut t_max| {
+                for b in prims(first, count) {
+                    if let Some(t) = box_prim(b, ray, t_max) {
+                        t_max = t;
+                        best = Some(t);
+                    }
+                }
+                t_max
+            },
+            |_| (),
+        );
+        let blocked = bvh.occluded::<K>(ray, t_max, |first, count, t_max| {
+            prims(first, count)
+                .iter()
+                .any(|b| box_prim(b, ray, t_max).is_some())
+        });
+        (best, blocked)
     }
 
     impl Node8 {
