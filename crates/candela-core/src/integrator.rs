@@ -242,10 +242,6 @@ pub fn li<S: Sampler>(scene: &Scene, mut ray: Ray, sampler: &mut S, rays: &mut u
             0.5
         };
         let u_point = sampler.get_2d();
-        if !bsdf.is_delta() {
-            l += beta * sample_direct(scene, &si, &ctx, &bsdf, wo, u_light, u_point, rays);
-        }
-
         let u_lobe = if bsdf.lobe.takes_lobe_sample() {
             sampler.get_1d()
         } else {
@@ -253,7 +249,13 @@ pub fn li<S: Sampler>(scene: &Scene, mut ray: Ray, sampler: &mut S, rays: &mut u
             0.5
         };
         let u_dir = sampler.get_2d();
-        let Some(bs) = bsdf.sample(wo, u_lobe, u_dir) else {
+        // The next direction first: it does not depend on light sampling, so its chain of
+        // divisions and square roots runs while the shadow ray is traced.
+        let bs = bsdf.sample(wo, u_lobe, u_dir);
+        if !bsdf.is_delta() {
+            l += beta * sample_direct(scene, &si, &ctx, &bsdf, wo, u_light, u_point, rays);
+        }
+        let Some(bs) = bs else {
             break;
         };
         beta *= bs.f * (bsdf.abs_cos(bs.wi) / bs.pdf);
