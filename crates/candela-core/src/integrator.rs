@@ -13,7 +13,8 @@ use crate::desc::{MisMode, SamplerKind};
 use crate::film::{Film, Pixel};
 use crate::filter::PixelFilter;
 use crate::geometry::Ray;
-use crate::light::{LightId, ShadingCtx};
+use crate::light::{Light, LightId, LightSample, ShadingCtx};
+use crate::light_sampler::LightPick;
 use crate::math::max_component;
 use crate::sampler::{IndependentSampler, Sampler, SobolSampler};
 use crate::sampling::{balance_heuristic, power_heuristic};
@@ -330,7 +331,50 @@ fn sample_direct(
     if mode == MisMode::BsdfOnly && !light.is_delta() {
         return Vec3::ZERO;
     }
-    let Some(ls) = light.sample_li(ctx, u_point) else {
+    // Flat area lights, most scenes' lamps, get copies of the rest of NEE of their own:
+    // merged with the other lights' samples, which come back through memory, their sample
+    // went through the stack too, stored field by field and loaded back in other pieces (a
+    // failed store forwarding on every shadow ray).
+    let ls = match light {
+        Light::Parallelogram(p) => p.sample_li(ctx, u_point),
+        Light::Triangle(t) => t.sample_li(ctx, u_point),
+        _ => {
+            return light_contribution(
+                scene,
+                si,
+                bsdf,
+                wo,
+                &pick,
+                light.sample_li(ctx, u_point),
+                rays,
+            )
+        }
+    };
+    light_contribution(
+        scene,
+        si,
+        bsdf,
+        wo,
+        &pick,
+        ls.and_then(LightSample::usable),
+        rays,
+    )
+}
+
+/// The rest of [`sample_direct`], from the light's sample on: the BSDF, the shadow ray and
+/// the MIS weight.
+#[inline(always)]
+fn light_contribution(
+    scene: &Scene,
+    si: &SurfaceInteraction,
+    bsdf: &Bsdf,
+    wo: Vec3,
+    pick: &LightPick,
+    ls: Option<LightSample>,
+    rays: &mut u64,
+) -> Vec3 {
+    let mode = scene.settings.mis;
+    let Some(ls) = ls else {
         return Vec3::ZERO;
     };
     let (f, bsdf_pdf) = bsdf.f_cos_pdf(wo, ls.wi);
