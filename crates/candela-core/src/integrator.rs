@@ -331,7 +331,7 @@ fn sample_direct(
     if mode == MisMode::BsdfOnly && !light.is_delta() {
         return Vec3::ZERO;
     }
-    // Flat area lights, most scenes' lamps, get copies of the rest of NEE of their own:
+    // Flat area lights, most scenes' lamps, get a copy of the rest of NEE of their own:
     // merged with the other lights' samples, which come back through memory, their sample
     // went through the stack too, stored field by field and loaded back in other pieces (a
     // failed store forwarding on every shadow ray).
