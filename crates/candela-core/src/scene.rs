@@ -465,26 +465,33 @@ fn triangle_dpdu_dpdv(p: [Vec3; 3], uv: [Vec2; 3]) -> (Vec3, Vec3) {
 mod tests {
     use super::*;
 
-    #[test]
-    fn a_bare_mesh_s_fast_hit_record_is_the_full_one() {
-        let mut m = Mesh {
-            positions: vec![
-                Vec3::new(0.1, 0.2, 0.3),
-                Vec3::new(1.7, -0.4, 0.2),
-                Vec3::new(0.3, 1.1, -0.9),
-                Vec3::new(-0.5, 0.6, 2.0),
-            ],
-            normals: vec![],
+    /// A world-space mesh of material 3 with no attributes but `normals`.
+    fn mesh(positions: Vec<Vec3>, normals: Vec<Vec3>, indices: Vec<[u32; 3]>) -> Mesh {
+        Mesh {
+            positions,
+            normals,
             uvs: vec![],
             colors: vec![],
             tangents: vec![],
-            indices: vec![[0, 1, 2], [2, 1, 3]],
+            indices,
             material: MaterialId(3),
-            lights: vec![LightId(4), LightId(7)],
+            lights: vec![],
             flip_normals: false,
             alpha: None,
             face_normals: vec![],
-        };
+        }
+    }
+
+    #[test]
+    fn a_bare_mesh_s_fast_hit_record_is_the_full_one() {
+        let positions = vec![
+            Vec3::new(0.1, 0.2, 0.3),
+            Vec3::new(1.7, -0.4, 0.2),
+            Vec3::new(0.3, 1.1, -0.9),
+            Vec3::new(-0.5, 0.6, 2.0),
+        ];
+        let mut m = mesh(positions, vec![], vec![[0, 1, 2], [2, 1, 3]]);
+        m.lights = vec![LightId(4), LightId(7)];
         for flip in [false, true] {
             m.flip_normals = flip;
             m.face_normals.clear();
@@ -510,23 +517,16 @@ mod tests {
         let si = triangle_interaction(&m, None, 1, 1.0, Vec2::splat(0.25));
         assert!(si.light.is_none());
     }
+
     #[test]
     fn cached_face_normals_are_the_computed_ones() {
         // Shading normals that disagree with the winding of the second triangle turn its
         // geometric normal; the cache must keep that and `flip_normals`.
-        let mut m = Mesh {
-            positions: vec![Vec3::ZERO, Vec3::X, Vec3::Y, Vec3::new(1.0, 1.0, 0.2)],
-            normals: vec![Vec3::Z, Vec3::Z, Vec3::Z, Vec3::Z],
-            uvs: vec![],
-            colors: vec![],
-            tangents: vec![],
-            indices: vec![[0, 1, 2], [1, 2, 3], [0, 0, 1]],
-            material: MaterialId(0),
-            lights: vec![],
-            flip_normals: false,
-            alpha: None,
-            face_normals: vec![],
-        };
+        let mut m = mesh(
+            vec![Vec3::ZERO, Vec3::X, Vec3::Y, Vec3::new(1.0, 1.0, 0.2)],
+            vec![Vec3::Z; 4],
+            vec![[0, 1, 2], [1, 2, 3], [0, 0, 1]],
+        );
         for flip in [false, true] {
             m.flip_normals = flip;
             m.face_normals.clear();
