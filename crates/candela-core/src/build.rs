@@ -195,6 +195,7 @@ pub fn build(desc: &SceneDesc) -> Result<Scene, BuildError> {
                 if let Some(le) = emission {
                     lights::triangle_lights(desc, shape_index, &mut mesh, le, &mut lights);
                 }
+                mesh.cache_face_normals();
                 meshes.push(mesh);
             }
         }
@@ -785,6 +786,7 @@ fn to_world(local: MeshDesc, m: Mat4, material: MaterialId) -> Mesh {
         lights: Vec::new(),
         flip_normals: false,
         alpha: None,
+        face_normals: Vec::new(),
     }
 }
 
@@ -803,6 +805,7 @@ fn object_space(local: MeshDesc, material: MaterialId) -> Mesh {
         lights: Vec::new(),
         flip_normals: false,
         alpha: None,
+        face_normals: Vec::new(),
     }
 }
 

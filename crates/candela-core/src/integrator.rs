@@ -13,7 +13,8 @@ use crate::desc::{MisMode, SamplerKind};
 use crate::film::{Film, Pixel};
 use crate::filter::PixelFilter;
 use crate::geometry::Ray;
-use crate::light::{LightId, ShadingCtx};
+use crate::light::{Light, LightId, LightSample, ShadingCtx};
+use crate::light_sampler::LightPick;
 use crate::math::max_component;
 use crate::sampler::{IndependentSampler, Sampler, SobolSampler};
 use crate::sampling::{balance_heuristic, power_heuristic};
@@ -193,6 +194,11 @@ pub fn li<S: Sampler>(scene: &Scene, mut ray: Ray, sampler: &mut S, rays: &mut u
 
     loop {
         *rays += 1;
+        // This bounce's numbers come before the traversal: they do not depend on the hit,
+        // and their hashing (tens of cycles of dependent multiplies) then overlaps the
+        // traversal instead of following it on the path's critical chain. The dimensions
+        // are those of drawing them where they are used; a path that ends here wastes them.
+        let u = (depth < scene.settings.max_depth).then(|| BounceSamples::draw(scene, sampler));
         let hit = scene.intersect(&ray, f32::INFINITY);
         if depth == 0
             && scene.settings.hide_emitters
@@ -221,34 +227,19 @@ pub fn li<S: Sampler>(scene: &Scene, mut ray: Ray, sampler: &mut S, rays: &mut u
                 l += beta * le * emitter_weight(specular, &prev_ctx, prev_bsdf_pdf, id, ray.d);
             }
         }
-        if depth == scene.settings.max_depth {
+        let Some(u) = u else {
             break;
-        }
+        };
 
         let bsdf = scene.materials[si.material.0 as usize].bsdf_at(&si);
         let ctx = ShadingCtx { p: si.p, n: si.ns };
-        // A number nothing reads is skipped, not computed (its dimension stays taken):
-        // the light pick where there is one light, the lobe choice of one-lobe BSDFs, and
-        // Russian roulette before it starts.
-        let u_light = if scene.lights.len() > 1 {
-            sampler.get_1d()
-        } else {
-            sampler.skip_1d();
-            0.5
-        };
-        let u_point = sampler.get_2d();
+        // The next direction first: it does not depend on light sampling, so its chain of
+        // divisions and square roots runs while the shadow ray is traced.
+        let bs = bsdf.sample(wo, u.lobe, u.dir);
         if !bsdf.is_delta() {
-            l += beta * sample_direct(scene, &si, &ctx, &bsdf, wo, u_light, u_point, rays);
+            l += beta * sample_direct(scene, &si, &ctx, &bsdf, wo, u.light, u.point, rays);
         }
-
-        let u_lobe = if bsdf.lobe.takes_lobe_sample() {
-            sampler.get_1d()
-        } else {
-            sampler.skip_1d();
-            0.5
-        };
-        let u_dir = sampler.get_2d();
-        let Some(bs) = bsdf.sample(wo, u_lobe, u_dir) else {
+        let Some(bs) = bs else {
             break;
         };
         beta *= bs.f * (bsdf.abs_cos(bs.wi) / bs.pdf);
@@ -279,6 +270,40 @@ pub fn li<S: Sampler>(scene: &Scene, mut ray: Ray, sampler: &mut S, rays: &mut u
     l
 }
 
+/// The numbers one bounce takes, in the order of their dimensions.
+struct BounceSamples {
+    /// The light pick (0.5, its dimension skipped, where there is one light).
+    light: f32,
+    /// The point on the light.
+    point: Vec2,
+    /// The BSDF's lobe choice (drawn even for one-lobe BSDFs: the hit is not known yet).
+    lobe: f32,
+    /// The BSDF direction.
+    dir: Vec2,
+}
+
+impl BounceSamples {
+    #[inline(always)]
+    fn draw<S: Sampler>(scene: &Scene, sampler: &mut S) -> BounceSamples {
+        // A number nothing reads is skipped, not computed (its dimension stays taken).
+        let light = if scene.lights.len() > 1 {
+            sampler.get_1d()
+        } else {
+            sampler.skip_1d();
+            0.5
+        };
+        let point = sampler.get_2d();
+        let lobe = sampler.get_1d();
+        let dir = sampler.get_2d();
+        BounceSamples {
+            light,
+            point,
+            lobe,
+            dir,
+        }
+    }
+}
+
 /// Next event estimation: one light picked by the light sampler, one point on it, a
 /// shadow ray, and the MIS weight against BSDF sampling of the same direction.
 #[allow(clippy::too_many_arguments)]
@@ -302,7 +327,50 @@ fn sample_direct(
     if mode == MisMode::BsdfOnly && !light.is_delta() {
         return Vec3::ZERO;
     }
-    let Some(ls) = light.sample_li(ctx, u_point) else {
+    // Flat area lights, most scenes' lamps, get a copy of the rest of NEE of their own:
+    // merged with the other lights' samples, which come back through memory, their sample
+    // went through the stack too, stored field by field and loaded back in other pieces (a
+    // failed store forwarding on every shadow ray).
+    let ls = match light {
+        Light::Parallelogram(p) => p.sample_li(ctx, u_point),
+        Light::Triangle(t) => t.sample_li(ctx, u_point),
+        _ => {
+            return light_contribution(
+                scene,
+                si,
+                bsdf,
+                wo,
+                &pick,
+                light.sample_li(ctx, u_point),
+                rays,
+            )
+        }
+    };
+    light_contribution(
+        scene,
+        si,
+        bsdf,
+        wo,
+        &pick,
+        ls.and_then(LightSample::usable),
+        rays,
+    )
+}
+
+/// The rest of [`sample_direct`], from the light's sample on: the BSDF, the shadow ray and
+/// the MIS weight.
+#[inline(always)]
+fn light_contribution(
+    scene: &Scene,
+    si: &SurfaceInteraction,
+    bsdf: &Bsdf,
+    wo: Vec3,
+    pick: &LightPick,
+    ls: Option<LightSample>,
+    rays: &mut u64,
+) -> Vec3 {
+    let mode = scene.settings.mis;
+    let Some(ls) = ls else {
         return Vec3::ZERO;
     };
     let (f, bsdf_pdf) = bsdf.f_cos_pdf(wo, ls.wi);

@@ -94,6 +94,13 @@ pub struct LightSample {
 }
 
 impl LightSample {
+    /// The sample if it carries light with a positive, finite density: the check
+    /// [`Light::sample_li`] applies to every light's sample.
+    #[inline(always)]
+    pub fn usable(self) -> Option<LightSample> {
+        (self.pdf > 0.0 && self.pdf.is_finite() && self.radiance != Vec3::ZERO).then_some(self)
+    }
+
     /// The sample of point `p`, drawn uniformly by area on a flat one-sided emitter of
     /// normal `n` and `area`, seen from `from`: the area density turned into solid angle,
     /// d²/(cos θ_l · A). `radiance(wi)` gives the radiance leaving towards −`wi`. `None`
@@ -156,7 +163,7 @@ impl Light {
             Light::Projector(l) => l.sample_li(ctx),
             Light::Environment(l) => l.sample_li(ctx, u),
         }?;
-        (s.pdf > 0.0 && s.pdf.is_finite() && s.radiance != Vec3::ZERO).then_some(s)
+        s.usable()
     }
 
     /// Density in solid angle with which [`Self::sample_li`] picks direction `wi` at `ctx`.
