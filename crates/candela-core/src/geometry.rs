@@ -91,8 +91,13 @@ impl Aabb {
         let (nz, fz) = pick(self.min.z, self.max.z, inv_d.z);
         let near = (Vec3::new(nx, ny, nz) - o) * inv_d;
         let far = (Vec3::new(fx, fy, fz) - o) * inv_d * (1.0 + 2.0 * gamma(3));
-        let t_near = near.max_element().max(0.0);
-        let t_far = far.min_element().min(t_max);
+        // A ray parallel to a slab and starting on one of its planes gives 0·∞ = NaN
+        // there. `f32::max` and `f32::min` drop a NaN operand, so that axis counts as
+        // inside its slab (conservative), and the other axes still decide; glam's
+        // `max_element`/`min_element` may instead carry the NaN through and accept a box
+        // whose other slab the ray misses.
+        let t_near = near.x.max(near.y).max(near.z).max(0.0);
+        let t_far = far.x.min(far.y).min(far.z).min(t_max);
         (t_near <= t_far).then_some(t_near)
     }
 }
@@ -345,5 +350,21 @@ mod tests {
         );
         assert!(Aabb::EMPTY.is_empty());
         assert_eq!(Aabb::EMPTY.hit(Vec3::ZERO, d.recip(), f32::INFINITY), None);
+        // Parallel to y and z, on the box's max-z plane (0·∞ = NaN there) but above its
+        // y slab: a miss, whichever axis order the NaN meets (the qbvh engineer's case).
+        let plane = Aabb {
+            min: Vec3::new(-10.0, 1.54, 0.0),
+            max: Vec3::new(10.0, 1.84, 1.796),
+        };
+        let x = Vec3::X.recip();
+        let above = Vec3::new(4.516, 9.584, 1.796);
+        assert_eq!(plane.hit(above, x, f32::INFINITY), None);
+        assert_eq!(
+            plane.hit(above * Vec3::new(-1.0, 1.0, 1.0), x, f32::INFINITY),
+            None
+        );
+        // On the plane and inside the y slab: the NaN axis counts as inside.
+        let on = Vec3::new(-12.0, 1.6, 1.796);
+        assert_eq!(plane.hit(on, x, f32::INFINITY), Some(2.0));
     }
 }

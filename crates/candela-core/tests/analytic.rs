@@ -211,7 +211,10 @@ fn russian_roulette_starts_after_rr_depth_bounces() {
             );
         }
         let pixels: Vec<f64> = result.film.resolve().iter().map(|v| v.x as f64).collect();
-        let expected = le * (0..=max_depth).map(|k| (rho as f64).powi(k as i32)).sum::<f64>();
+        let expected = le
+            * (0..=max_depth)
+                .map(|k| (rho as f64).powi(k as i32))
+                .sum::<f64>();
         check_uniform(
             &format!("sphere ρ = {rho}, max_depth {max_depth}, rr_depth {rr_depth}, {sampler:?}"),
             &pixels,

@@ -397,7 +397,10 @@ fn eta_crossed_sq_undoes_the_radiance_scaling_of_refraction() {
                 }
             }
         }
-        assert!(refracted > 0 && reflected > 0, "η {eta}: {refracted} / {reflected}");
+        assert!(
+            refracted > 0 && reflected > 0,
+            "η {eta}: {refracted} / {reflected}"
+        );
     }
     let diffuse = Bsdf::new(ns, ns, Lobe::Diffuse(Diffuse { albedo: Vec3::ONE }));
     let wo = Vec3::new(0.2, 0.1, 0.9).normalize();

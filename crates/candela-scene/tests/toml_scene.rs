@@ -90,7 +90,12 @@ fn render_settings_and_camera() {
     // Defaults when the sections are absent.
     let d = parse("");
     assert_eq!(
-        (d.render.width, d.render.spp, d.render.max_depth, d.render.rr_depth),
+        (
+            d.render.width,
+            d.render.spp,
+            d.render.max_depth,
+            d.render.rr_depth
+        ),
         (512, 64, 8, 5)
     );
     assert_eq!(d.camera.fov_y_deg, 40.0);
