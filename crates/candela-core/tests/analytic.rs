@@ -132,6 +132,26 @@ fn inside_camera(position: Vec3, look_at: Vec3) -> CameraDesc {
     }
 }
 
+/// The inside of a unit sphere of albedo `rho` emitting `le` everywhere, seen from inside.
+fn closed_sphere(rho: f32, le: f32, render: RenderSettings) -> SceneDesc {
+    let mut desc = SceneDesc {
+        camera: inside_camera(Vec3::new(0.2, -0.1, 0.3), Vec3::new(0.0, 0.4, -1.0)),
+        render,
+        ..Default::default()
+    };
+    desc.materials.push(material("wall", rho));
+    desc.shapes.push(shape(
+        GeometryDesc::Sphere {
+            center: Vec3::ZERO,
+            radius: 1.0,
+        },
+        "wall",
+        Some(le),
+        true,
+    ));
+    desc
+}
+
 #[test]
 fn closed_emitting_sphere_has_radiance_le_over_one_minus_albedo() {
     // Every surface point emits Le and reflects ρ of the uniform radiance L around it:
@@ -143,21 +163,7 @@ fn closed_emitting_sphere_has_radiance_le_over_one_minus_albedo() {
         .flat_map(|r| SAMPLERS.map(|s| (r, s)))
     {
         for mis in MIS_MODES {
-            let mut desc = SceneDesc {
-                camera: inside_camera(Vec3::new(0.2, -0.1, 0.3), Vec3::new(0.0, 0.4, -1.0)),
-                render: settings(sampler, mis, 1000, 64, 17),
-                ..Default::default()
-            };
-            desc.materials.push(material("wall", rho));
-            desc.shapes.push(shape(
-                GeometryDesc::Sphere {
-                    center: Vec3::ZERO,
-                    radius: 1.0,
-                },
-                "wall",
-                Some(le),
-                true,
-            ));
+            let desc = closed_sphere(rho, le, settings(sampler, mis, 1000, 64, 17));
             let expected = le as f64 / (1.0 - rho as f64);
             check_uniform(
                 &format!("sphere ρ = {rho}, {mis:?}, {sampler:?}"),
@@ -181,24 +187,11 @@ fn russian_roulette_starts_after_rr_depth_bounces() {
         .into_iter()
         .flat_map(|d| SAMPLERS.map(|s| (d, s)))
     {
-        let mut desc = SceneDesc {
-            camera: inside_camera(Vec3::new(0.2, -0.1, 0.3), Vec3::new(0.0, 0.4, -1.0)),
-            render: RenderSettings {
-                rr_depth,
-                ..settings(sampler, MisMode::BsdfOnly, max_depth, 64, 41)
-            },
-            ..Default::default()
+        let with_rr = RenderSettings {
+            rr_depth,
+            ..settings(sampler, MisMode::BsdfOnly, max_depth, 64, 41)
         };
-        desc.materials.push(material("wall", rho));
-        desc.shapes.push(shape(
-            GeometryDesc::Sphere {
-                center: Vec3::ZERO,
-                radius: 1.0,
-            },
-            "wall",
-            Some(le as f32),
-            true,
-        ));
+        let desc = closed_sphere(rho, le as f32, with_rr);
         let scene = build(&desc).expect("scene builds");
         let result = render(&scene, 0..64, &AtomicBool::new(false), &|_| {});
         let (paths, rays) = (result.stats.paths, result.stats.rays);
