@@ -81,8 +81,8 @@ impl WideNode for Node8 {
     }
 }
 
-/// [`Node8`] with its child boxes quantized to bytes ([`QBoxes8`]): 114 bytes, two
-/// cache lines instead of four. `used` has bit `i` set for each child slot in use; the
+/// [`Node8`] with its child boxes quantized to bytes ([`QBoxes8`]): 128 bytes (two
+/// cache lines) instead of 256. `used` has bit `i` set for each child slot in use; the
 /// others' bytes mean nothing and their hits are masked off.
 #[derive(Clone, Copy, Debug)]
 #[repr(C, align(64))]
