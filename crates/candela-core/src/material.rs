@@ -71,8 +71,29 @@ impl Material {
     /// The BSDF at a surface interaction: its shading frame (tangent `dpdu`, bitangent
     /// sign), uvs, and vertex colour multiplying the base colour (diffuse and plastic
     /// albedo, metal_rough base colour; other lobes ignore it).
-    #[inline]
+    ///
+    /// A constant Lambertian material, most scenes' walls, is handled here and inlined
+    /// into the caller, which then reads the BSDF from registers rather than back from
+    /// the stack in other pieces than it was written; the rest goes through
+    /// [`Self::bsdf_at_general`].
+    #[inline(always)]
     pub fn bsdf_at(&self, si: &SurfaceInteraction) -> Bsdf {
+        if let Material::Diffuse {
+            albedo: Texture::Constant(albedo),
+        } = self
+        {
+            // What `lobe` makes of it: the texture's value times the vertex colour.
+            let lobe = Lobe::Diffuse(Diffuse {
+                albedo: *albedo * si.color,
+            });
+            return Bsdf::new(si.ns, si.ng, lobe);
+        }
+        self.bsdf_at_general(si)
+    }
+
+    /// [`Self::bsdf_at`] of every material but a constant Lambertian one.
+    #[inline(never)]
+    fn bsdf_at_general(&self, si: &SurfaceInteraction) -> Bsdf {
         match self {
             Material::NormalMap { map, inner } => {
                 let texel = map.eval(si.uv);

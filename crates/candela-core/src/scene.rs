@@ -43,6 +43,7 @@ pub struct Mesh {
 }
 
 impl Mesh {
+    #[inline]
     pub fn vertices(&self, tri: u32) -> [Vec3; 3] {
         let [a, b, c] = self.indices[tri as usize];
         [
@@ -217,28 +218,40 @@ impl Scene {
     }
 
     /// The nearest surface along the ray within (0, t_max).
+    ///
+    /// Inlined, with the instances and spheres out of line: the hit record of a flat
+    /// triangle, what the integrator reads first after every traversal, is then built in
+    /// the caller's registers instead of being stored field by field into the caller's
+    /// frame and loaded back in wider pieces (a failed store forwarding on every bounce).
+    #[inline(always)]
     pub fn intersect(&self, ray: &Ray, t_max: f32) -> Option<SurfaceInteraction> {
         let hit = self
             .accel
             .intersect(ray, t_max, |i, hit| self.alpha_accepts(i, hit, ray));
         if !self.instances.is_empty() {
-            let t_flat = hit.map_or(t_max, |h| h.t);
-            let filter = |inst, tri, hit: &_| self.instance_alpha_accepts(inst, tri, hit, ray);
-            if let Some(h) = self.instances.intersect(ray, t_flat, filter) {
-                let inst = &self.instances.instances[h.instance as usize];
-                let m = &self.instances.meshes[inst.mesh as usize];
-                return Some(triangle_interaction(
-                    m,
-                    Some(inst),
-                    h.tri,
-                    h.t,
-                    Vec2::new(h.b1, h.b2),
-                ));
+            if let Some(si) = self.intersect_instances(ray, hit.map_or(t_max, |h| h.t)) {
+                return Some(si);
             }
         }
         let hit = hit?;
         let prim = self.prims[hit.prim as usize];
         Some(self.interaction(ray, prim, hit.t, Vec2::new(hit.b1, hit.b2)))
+    }
+
+    /// The nearest instanced surface along the ray within (0, t_max).
+    #[inline(never)]
+    fn intersect_instances(&self, ray: &Ray, t_max: f32) -> Option<SurfaceInteraction> {
+        let filter = |inst, tri, hit: &_| self.instance_alpha_accepts(inst, tri, hit, ray);
+        let h = self.instances.intersect(ray, t_max, filter)?;
+        let inst = &self.instances.instances[h.instance as usize];
+        let m = &self.instances.meshes[inst.mesh as usize];
+        Some(triangle_interaction(
+            m,
+            Some(inst),
+            h.tri,
+            h.t,
+            Vec2::new(h.b1, h.b2),
+        ))
     }
 
     /// Whether anything lies on the ray within (0, t_max).
@@ -294,37 +307,41 @@ impl Scene {
         !self.occluded(&Ray::new(o, d), f32::INFINITY)
     }
 
-    #[inline]
+    #[inline(always)]
     fn interaction(&self, ray: &Ray, prim: Prim, t: f32, bary: Vec2) -> SurfaceInteraction {
         match prim {
             Prim::Triangle { mesh, tri } => {
                 triangle_interaction(&self.meshes[mesh as usize], None, tri, t, bary)
             }
-            Prim::Sphere(i) => {
-                let s = &self.spheres[i as usize];
-                let n_out = (ray.at(t) - s.center).normalize();
-                // Project back onto the surface to remove the error of o + t·d.
-                let p = s.center + n_out * s.radius;
-                let n = if s.flip_normals { -n_out } else { n_out };
-                let phi = n_out.z.atan2(n_out.x);
-                let uv = Vec2::new(
-                    (phi / std::f32::consts::TAU).rem_euclid(1.0),
-                    n_out.y.clamp(-1.0, 1.0).acos() / std::f32::consts::PI,
-                );
-                SurfaceInteraction {
-                    p,
-                    t,
-                    ng: n,
-                    ns: n,
-                    uv,
-                    // u grows with φ = atan2(z, x): along (−z, 0, x) of the normal.
-                    dpdu: Vec3::new(-n_out.z, 0.0, n_out.x),
-                    bitangent_sign: 1.0,
-                    color: Vec3::ONE,
-                    material: s.material,
-                    light: s.light,
-                }
-            }
+            Prim::Sphere(i) => self.sphere_interaction(ray, i, t),
+        }
+    }
+
+    /// The hit record of sphere `i` at distance `t` along the ray.
+    #[inline(never)]
+    fn sphere_interaction(&self, ray: &Ray, i: u32, t: f32) -> SurfaceInteraction {
+        let s = &self.spheres[i as usize];
+        let n_out = (ray.at(t) - s.center).normalize();
+        // Project back onto the surface to remove the error of o + t·d.
+        let p = s.center + n_out * s.radius;
+        let n = if s.flip_normals { -n_out } else { n_out };
+        let phi = n_out.z.atan2(n_out.x);
+        let uv = Vec2::new(
+            (phi / std::f32::consts::TAU).rem_euclid(1.0),
+            n_out.y.clamp(-1.0, 1.0).acos() / std::f32::consts::PI,
+        );
+        SurfaceInteraction {
+            p,
+            t,
+            ng: n,
+            ns: n,
+            uv,
+            // u grows with φ = atan2(z, x): along (−z, 0, x) of the normal.
+            dpdu: Vec3::new(-n_out.z, 0.0, n_out.x),
+            bitangent_sign: 1.0,
+            color: Vec3::ONE,
+            material: s.material,
+            light: s.light,
         }
     }
 }
@@ -332,7 +349,7 @@ impl Scene {
 /// The hit record of triangle `tri` of `m` at barycentrics `bary`: a world-space mesh's
 /// where `inst` is `None`, else an instance's, whose object-space vertex data is carried to
 /// world space first by the same [`crate::instance::Transform`] that flattens meshes.
-#[inline]
+#[inline(always)]
 fn triangle_interaction(
     m: &Mesh,
     inst: Option<&Instance>,

@@ -281,36 +281,48 @@ impl Bsdf {
         (self.lobe.f(lo, li) * li.z.abs(), self.lobe.pdf(lo, li))
     }
 
-    #[inline]
+    /// Samples a direction. The Lambertian lobe, most scenes' walls, is handled here and
+    /// inlined into the caller, so that `wo` and the frame stay in registers instead of
+    /// going through the stack (stored field by field, loaded back whole: a failed store
+    /// forwarding on every bounce); the other lobes go through [`Self::sample_lobe`].
+    #[inline(always)]
     pub fn sample(&self, wo: Vec3, u_lobe: f32, u: Vec2) -> Option<BsdfSample> {
-        let (cos_o, s) = match &self.lobe {
-            // The Lambertian lobe reads only the cosine of `wo` (one dot product, not a
-            // change of frame) and is two-sided already (no mirroring of `wo` and back).
-            Lobe::Diffuse(d) => {
-                let cos_o = wo.dot(self.frame.n);
-                if self.blind(cos_o) {
-                    return None;
-                }
-                let s = d.sample_from(cos_o, u)?;
-                // Its pdf, |cos θᵢ|/π, is positive (or no sample) and finite, so wi.z ≠ 0:
-                // only f is left to check.
-                if !s.f.is_finite() {
-                    return None;
-                }
-                (cos_o, s)
-            }
-            lobe => {
-                let lo = self.frame.to_local(wo);
-                if self.blind(lo.z) {
-                    return None;
-                }
-                let s = lobe.sample(lo, u_lobe, u)?;
-                if s.pdf == 0.0 || !s.pdf.is_finite() || s.wi.z == 0.0 || !s.f.is_finite() {
-                    return None;
-                }
-                (lo.z, s)
-            }
+        let Lobe::Diffuse(d) = &self.lobe else {
+            return self.sample_lobe(wo, u_lobe, u);
         };
+        // The Lambertian lobe reads only the cosine of `wo` (one dot product, not a
+        // change of frame) and is two-sided already (no mirroring of `wo` and back).
+        let cos_o = wo.dot(self.frame.n);
+        if self.blind(cos_o) {
+            return None;
+        }
+        let s = d.sample_from(cos_o, u)?;
+        // Its pdf, |cos θᵢ|/π, is positive (or no sample) and finite, so wi.z ≠ 0: only f
+        // is left to check.
+        if !s.f.is_finite() {
+            return None;
+        }
+        self.checked_to_world(wo, cos_o, s)
+    }
+
+    /// [`Self::sample`] of every lobe but the Lambertian one.
+    #[inline(never)]
+    fn sample_lobe(&self, wo: Vec3, u_lobe: f32, u: Vec2) -> Option<BsdfSample> {
+        let lo = self.frame.to_local(wo);
+        if self.blind(lo.z) {
+            return None;
+        }
+        let s = self.lobe.sample(lo, u_lobe, u)?;
+        if s.pdf == 0.0 || !s.pdf.is_finite() || s.wi.z == 0.0 || !s.f.is_finite() {
+            return None;
+        }
+        self.checked_to_world(wo, lo.z, s)
+    }
+
+    /// A local sample `s` for `wo` (of shading cosine `cos_o`) in world space, unless its
+    /// geometric and shading sides disagree.
+    #[inline(always)]
+    fn checked_to_world(&self, wo: Vec3, cos_o: f32, s: BsdfSample) -> Option<BsdfSample> {
         let wi = self.frame.to_world(s.wi);
         if !self.sides_agree(wo, wi, cos_o, s.wi.z) {
             return None;
