@@ -198,7 +198,8 @@ pub fn li<S: Sampler>(scene: &Scene, mut ray: Ray, sampler: &mut S, rays: &mut u
         // and their hashing (tens of cycles of dependent multiplies) then overlaps the
         // traversal instead of following it on the path's critical chain. The dimensions
         // are those of drawing them where they are used; a path that ends here wastes them.
-        let u = (depth < scene.settings.max_depth).then(|| BounceSamples::draw(scene, sampler));
+        let u =
+            (depth < scene.settings.max_depth).then(|| BounceSamples::<S>::draw(scene, sampler));
         let hit = scene.intersect(&ray, f32::INFINITY);
         if depth == 0
             && scene.settings.hide_emitters
@@ -235,7 +236,12 @@ pub fn li<S: Sampler>(scene: &Scene, mut ray: Ray, sampler: &mut S, rays: &mut u
         let ctx = ShadingCtx { p: si.p, n: si.ns };
         // The next direction first: it does not depend on light sampling, so its chain of
         // divisions and square roots runs while the shadow ray is traced.
-        let bs = bsdf.sample(wo, u.lobe, u.dir);
+        let u_lobe = if bsdf.lobe.takes_lobe_sample() {
+            sampler.resolve_1d(u.lobe)
+        } else {
+            0.5
+        };
+        let bs = bsdf.sample(wo, u_lobe, u.dir);
         if !bsdf.is_delta() {
             l += beta * sample_direct(scene, &si, &ctx, &bsdf, wo, u.light, u.point, rays);
         }
@@ -271,20 +277,21 @@ pub fn li<S: Sampler>(scene: &Scene, mut ray: Ray, sampler: &mut S, rays: &mut u
 }
 
 /// The numbers one bounce takes, in the order of their dimensions.
-struct BounceSamples {
+struct BounceSamples<S: Sampler> {
     /// The light pick (0.5, its dimension skipped, where there is one light).
     light: f32,
     /// The point on the light.
     point: Vec2,
-    /// The BSDF's lobe choice (drawn even for one-lobe BSDFs: the hit is not known yet).
-    lobe: f32,
+    /// The BSDF's lobe choice, deferred: the hit is not known yet, and most BSDFs (one
+    /// lobe) do not read it.
+    lobe: S::Deferred1d,
     /// The BSDF direction.
     dir: Vec2,
 }
 
-impl BounceSamples {
+impl<S: Sampler> BounceSamples<S> {
     #[inline(always)]
-    fn draw<S: Sampler>(scene: &Scene, sampler: &mut S) -> BounceSamples {
+    fn draw(scene: &Scene, sampler: &mut S) -> BounceSamples<S> {
         // A number nothing reads is skipped, not computed (its dimension stays taken).
         let light = if scene.lights.len() > 1 {
             sampler.get_1d()
@@ -293,7 +300,7 @@ impl BounceSamples {
             0.5
         };
         let point = sampler.get_2d();
-        let lobe = sampler.get_1d();
+        let lobe = sampler.defer_1d();
         let dir = sampler.get_2d();
         BounceSamples {
             light,

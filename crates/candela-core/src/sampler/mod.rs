@@ -33,6 +33,15 @@ pub trait Sampler: Send + Sync + Clone {
     fn get_pixel_2d(&mut self) -> Vec2 {
         self.get_2d()
     }
+    /// What [`Self::defer_1d`] keeps.
+    type Deferred1d: Copy;
+    /// Takes the next 1D request's place, like [`Self::skip_1d`], but keeps what
+    /// [`Self::resolve_1d`] needs to compute it later in the same pixel sample, where it
+    /// equals what [`Self::get_1d`] would have returned here: for a number that only some
+    /// consumers read (a BSDF's lobe choice, before the hit says which BSDF).
+    fn defer_1d(&mut self) -> Self::Deferred1d;
+    /// The value of a request [`Self::defer_1d`] deferred in the current pixel sample.
+    fn resolve_1d(&self, d: Self::Deferred1d) -> f32;
 }
 
 /// Independent uniform random numbers from PCG32 (O'Neill 2014), one stream per pixel
@@ -72,6 +81,17 @@ impl Sampler for IndependentSampler {
 
     fn skip_1d(&mut self) {
         self.rng.next_u32();
+    }
+
+    /// A sequential stream cannot compute a request out of order: the number is drawn now.
+    type Deferred1d = f32;
+
+    fn defer_1d(&mut self) -> f32 {
+        self.get_1d()
+    }
+
+    fn resolve_1d(&self, u: f32) -> f32 {
+        u
     }
 }
 
@@ -157,6 +177,27 @@ mod tests {
     fn skipping_a_request_keeps_the_later_ones_in_place() {
         skipping_keeps_later_requests(IndependentSampler::new(3), IndependentSampler::new(3));
         skipping_keeps_later_requests(SobolSampler::new(3), SobolSampler::new(3));
+    }
+
+    /// A deferred request resolves, after later requests, to what `get_1d` gives in its
+    /// place, and the requests after it are those after `get_1d`.
+    fn deferring_equals_drawing<S: Sampler>(mut a: S, mut b: S) {
+        for index in 0..4 {
+            a.start_pixel_sample(UVec2::new(5, 6), index);
+            b.start_pixel_sample(UVec2::new(5, 6), index);
+            let _ = (a.get_2d(), b.get_2d());
+            let want = a.get_1d();
+            let d = b.defer_1d();
+            assert_eq!(a.get_2d(), b.get_2d());
+            assert_eq!(a.get_1d(), b.get_1d());
+            assert_eq!(b.resolve_1d(d), want);
+        }
+    }
+
+    #[test]
+    fn a_deferred_request_is_the_one_drawn_in_its_place() {
+        deferring_equals_drawing(IndependentSampler::new(3), IndependentSampler::new(3));
+        deferring_equals_drawing(SobolSampler::new(3), SobolSampler::new(3));
     }
 
     #[test]

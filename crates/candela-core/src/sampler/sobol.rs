@@ -147,14 +147,29 @@ impl SobolSampler {
     /// shuffled index `owen_scramble(index, low half of the hash)`.
     #[inline]
     fn next_request(&mut self, width: u32) -> (u32, u64) {
+        let r = self.request_at(self.dimension);
+        self.dimension += width;
+        r
+    }
+
+    /// [`Self::next_request`] of the request at `dimension`.
+    #[inline(always)]
+    fn request_at(&self, dimension: u32) -> (u32, u64) {
         const GOLDEN: u64 = 0x9e37_79b9_7f4a_7c15;
         let h = mix64(
             self.pixel_key
-                .wrapping_add((self.dimension as u64).wrapping_mul(GOLDEN)),
+                .wrapping_add((dimension as u64).wrapping_mul(GOLDEN)),
         );
-        self.dimension += width;
         let shuffled = scramble_reversed(self.index_reversed, h as u32).reverse_bits();
         (shuffled, h)
+    }
+
+    /// The 1D number of request `(i, h)`.
+    #[inline(always)]
+    fn number_1d((i, h): (u32, u64)) -> f32 {
+        // The first coordinate of point i is reverse(i); its scramble works on reverse of
+        // that, i itself.
+        to_unit(scramble_reversed(i, (h >> 32) as u32).reverse_bits())
     }
 }
 
@@ -175,15 +190,27 @@ impl Sampler for SobolSampler {
 
     #[inline]
     fn get_1d(&mut self) -> f32 {
-        // The first coordinate of point i is reverse(i); its scramble works on reverse of
-        // that, i itself.
-        let (i, h) = self.next_request(1);
-        to_unit(scramble_reversed(i, (h >> 32) as u32).reverse_bits())
+        Self::number_1d(self.next_request(1))
     }
 
     #[inline]
     fn skip_1d(&mut self) {
         self.dimension += 1;
+    }
+
+    /// The request's dimension: the pixel sample's key and index are still the sampler's
+    /// when it is resolved.
+    type Deferred1d = u32;
+
+    #[inline]
+    fn defer_1d(&mut self) -> u32 {
+        self.dimension += 1;
+        self.dimension - 1
+    }
+
+    #[inline]
+    fn resolve_1d(&self, dimension: u32) -> f32 {
+        Self::number_1d(self.request_at(dimension))
     }
 
     #[inline]
