@@ -73,9 +73,8 @@ impl Material {
     /// albedo, metal_rough base colour; other lobes ignore it).
     ///
     /// A constant Lambertian material, most scenes' walls, is handled here and inlined
-    /// into the caller, which then reads the BSDF from registers rather than back from
-    /// the stack in other pieces than it was written; the rest goes through
-    /// [`Self::bsdf_at_general`].
+    /// into the caller, which then need not read the BSDF back from memory; the rest goes
+    /// through [`Self::bsdf_at_general`].
     #[inline(always)]
     pub fn bsdf_at(&self, si: &SurfaceInteraction) -> Bsdf {
         if let Material::Diffuse {

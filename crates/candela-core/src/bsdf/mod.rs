@@ -282,9 +282,10 @@ impl Bsdf {
     }
 
     /// Samples a direction. The Lambertian lobe, most scenes' walls, is handled here and
-    /// inlined into the caller, so that `wo` and the frame stay in registers instead of
-    /// going through the stack (stored field by field, loaded back whole: a failed store
-    /// forwarding on every bounce); the other lobes go through [`Self::sample_lobe`].
+    /// inlined into the caller, so that `wo` and the frame need not be passed through
+    /// memory (out of line, the loads of `wo` and of the normal, stored just before in
+    /// other pieces, were this function's hottest instructions); the other lobes go
+    /// through [`Self::sample_lobe`].
     #[inline(always)]
     pub fn sample(&self, wo: Vec3, u_lobe: f32, u: Vec2) -> Option<BsdfSample> {
         let Lobe::Diffuse(d) = &self.lobe else {
