@@ -363,6 +363,15 @@ mod tests {
     }
 
     #[test]
+    fn isa_flag_sets_the_render_loop_copy() {
+        assert_eq!(overridden(&[]).render.isa, Isa::Auto);
+        assert_eq!(overridden(&["--isa", "baseline"]).render.isa, Isa::Baseline);
+        assert_eq!(overridden(&["--isa", "v3"]).render.isa, Isa::V3);
+        let cli = Cli::try_parse_from(["candela", "s.toml", "-o", "x.png", "--isa", "v4"]);
+        assert!(cli.is_err(), "an unknown copy is refused");
+    }
+
+    #[test]
     fn lens_flags_turn_a_pinhole_into_a_thin_lens() {
         assert!(overridden(&[]).camera.lens.is_none());
         let lens = overridden(&["--f-number", "2.8"]).camera.lens.unwrap();

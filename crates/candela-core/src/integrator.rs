@@ -9,7 +9,7 @@ use glam::{UVec2, Vec2, Vec3};
 use rayon::prelude::*;
 
 use crate::bsdf::Bsdf;
-use crate::desc::{Isa, MisMode, SamplerKind};
+use crate::desc::{MisMode, SamplerKind};
 use crate::film::{Film, Pixel};
 use crate::filter::PixelFilter;
 use crate::geometry::Ray;
@@ -77,7 +77,7 @@ pub fn render(
 }
 
 /// [`render`] with a given sampler, monomorphized so that no sample is a dynamic call.
-/// The scene's [`Isa`] chooses the compiled copy of the render loop.
+/// The scene's [`crate::desc::Isa`] chooses the compiled copy of the render loop.
 pub fn render_with<S: Sampler>(
     scene: &Scene,
     sampler: S,
@@ -107,17 +107,20 @@ pub fn render_with<S: Sampler>(
                     return RenderStats::default();
                 }
                 let mut sampler = sampler.clone();
-                let y0 = (band * BAND_ROWS) as u32;
-                let band_pass = pass.clone();
+                let done = pixels.len() as u64 * pass.len() as u64;
+                let band = Band {
+                    pixels,
+                    width: w,
+                    y0: (band * BAND_ROWS) as u32,
+                    pass: pass.clone(),
+                };
                 let s = match isa {
                     // SAFETY: the assertion above checked that the CPU has x86-64-v3.
                     #[cfg(target_arch = "x86_64")]
-                    Isa::V3 => unsafe {
-                        render_pixels_v3(scene, &mut sampler, pixels, w, y0, band_pass)
-                    },
-                    _ => render_pixels(scene, &mut sampler, pixels, w, y0, band_pass),
+                    crate::desc::Isa::V3 => unsafe { render_pixels_v3(scene, &mut sampler, band) },
+                    _ => render_pixels(scene, &mut sampler, band),
                 };
-                progress(pixels.len() as u64 * pass.len() as u64);
+                progress(done);
                 s
             })
             .reduce(RenderStats::default, RenderStats::add);
@@ -138,28 +141,29 @@ pub fn render_with<S: Sampler>(
 #[target_feature(
     enable = "avx,avx2,bmi1,bmi2,cmpxchg16b,f16c,fma,lzcnt,movbe,popcnt,sse3,sse4.1,sse4.2,ssse3,xsave"
 )]
-fn render_pixels_v3<S: Sampler>(
-    scene: &Scene,
-    sampler: &mut S,
-    pixels: &mut [Pixel],
-    width: u32,
-    y0: u32,
-    pass: Range<u32>,
-) -> RenderStats {
-    render_pixels(scene, sampler, pixels, width, y0, pass)
+fn render_pixels_v3<S: Sampler>(scene: &Scene, sampler: &mut S, band: Band) -> RenderStats {
+    render_pixels(scene, sampler, band)
 }
 
-/// Samples `pass` of a band of pixels starting at row `y0`; inlined into each copy of the
-/// render loop, so that it and its callees are compiled for each.
-#[inline(always)]
-fn render_pixels<S: Sampler>(
-    scene: &Scene,
-    sampler: &mut S,
-    pixels: &mut [Pixel],
+/// One work item: rows from `y0` of an image `width` pixels wide, and the sample indices
+/// to take in each of their pixels.
+struct Band<'a> {
+    pixels: &'a mut [Pixel],
     width: u32,
     y0: u32,
     pass: Range<u32>,
-) -> RenderStats {
+}
+
+/// Takes a band's samples; inlined into each copy of the render loop, so that it and
+/// its callees are compiled for each.
+#[inline(always)]
+fn render_pixels<S: Sampler>(scene: &Scene, sampler: &mut S, band: Band) -> RenderStats {
+    let Band {
+        pixels,
+        width,
+        y0,
+        pass,
+    } = band;
     let mut stats = RenderStats::default();
     for (i, pixel) in pixels.iter_mut().enumerate() {
         let p = UVec2::new(i as u32 % width, y0 + i as u32 / width);
