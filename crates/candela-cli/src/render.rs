@@ -11,8 +11,8 @@ use std::sync::Arc;
 use std::time::Instant;
 
 use candela_core::desc::{
-    ApertureSizeDesc, EnvironmentDesc, EnvironmentMapDesc, FocusDesc, LensDesc, LightSamplerKind,
-    MisMode, SamplerKind, SceneDesc, Span,
+    ApertureSizeDesc, EnvironmentDesc, EnvironmentMapDesc, FocusDesc, Isa, LensDesc,
+    LightSamplerKind, MisMode, SamplerKind, SceneDesc, Span,
 };
 use candela_core::integrator;
 use clap::Args;
@@ -118,6 +118,10 @@ pub struct RenderArgs {
     /// Sobol' points, stratified within each pixel).
     #[arg(long, value_parser = parse_name::<SamplerKind>)]
     sampler: Option<SamplerKind>,
+    /// Which compiled copy of the render loop runs: auto (the fastest the CPU has),
+    /// baseline (any x86-64) or v3 (x86-64-v3: AVX2, FMA, BMI2). Same pixels with each.
+    #[arg(long, value_parser = parse_name::<Isa>)]
+    isa: Option<Isa>,
     /// Focus distance of a thin lens, in scene units along the view axis (a pinhole
     /// scene also needs --f-number to blur).
     #[arg(long, allow_negative_numbers = true)]
@@ -177,6 +181,7 @@ impl RenderArgs {
             r.ris_candidates = n;
         }
         r.sampler = self.sampler.unwrap_or(r.sampler);
+        r.isa = self.isa.unwrap_or(r.isa);
         if self.focus_distance.is_some() || self.f_number.is_some() {
             let lens = desc.camera.lens.get_or_insert_with(LensDesc::default);
             if let Some(d) = self.focus_distance {
@@ -255,6 +260,12 @@ pub fn run(args: RenderArgs) -> Result<ExitCode, UserError> {
     ImageFormat::from_path(&args.output)?;
     let mut desc = args.load.load(&args.scene)?;
     args.apply_overrides(&mut desc);
+    if !desc.render.isa.is_supported() {
+        return Err(UserError(format!(
+            "--isa {:?}: this CPU cannot run it",
+            desc.render.isa
+        )));
+    }
     args.apply_environment(&mut desc)?;
     let built = Instant::now();
     let scene = candela_core::build::build(&desc)?;
@@ -349,6 +360,15 @@ mod tests {
         let mut desc = SceneDesc::default();
         cli.render.apply_overrides(&mut desc);
         desc
+    }
+
+    #[test]
+    fn isa_flag_sets_the_render_loop_copy() {
+        assert_eq!(overridden(&[]).render.isa, Isa::Auto);
+        assert_eq!(overridden(&["--isa", "baseline"]).render.isa, Isa::Baseline);
+        assert_eq!(overridden(&["--isa", "v3"]).render.isa, Isa::V3);
+        let cli = Cli::try_parse_from(["candela", "s.toml", "-o", "x.png", "--isa", "v4"]);
+        assert!(cli.is_err(), "an unknown copy is refused");
     }
 
     #[test]

@@ -567,6 +567,23 @@ pub enum SamplerKind {
     Sobol,
 }
 
+/// Which compiled copy of the render loop runs (see [`crate::isa`]). Its names on the
+/// command line are `auto`, `baseline` and `v3`. Every choice renders the same pixels,
+/// bit for bit; only the speed differs.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Isa {
+    /// The fastest copy the CPU runs: [`Isa::V3`] where it has x86-64-v3, else
+    /// [`Isa::Baseline`].
+    #[default]
+    Auto,
+    /// The copy compiled for the build's target (on x86-64, any x86-64 CPU).
+    Baseline,
+    /// The copy compiled for x86-64-v3 (AVX2, FMA, BMI1/2, LZCNT, MOVBE, F16C); only
+    /// on x86-64 CPUs that have them.
+    V3,
+}
+
 /// Default number of RIS candidates, chosen by `bench/many_lights`.
 pub const DEFAULT_RIS_CANDIDATES: u32 = 2;
 
@@ -596,6 +613,9 @@ pub struct RenderSettings {
     /// all, as with Mitsuba's `hide_emitters` (the emitters still light the scene).
     pub hide_emitters: bool,
     pub filter: PixelFilterDesc,
+    /// Which compiled copy of the render loop runs; it must be supported by the CPU
+    /// ([`Isa::is_supported`]).
+    pub isa: Isa,
 }
 
 /// The pixel reconstruction filter (see [`crate::filter`]); radii in pixels.
@@ -629,6 +649,7 @@ impl Default for RenderSettings {
             sampler: SamplerKind::default(),
             hide_emitters: false,
             filter: PixelFilterDesc::Box,
+            isa: Isa::Auto,
         }
     }
 }

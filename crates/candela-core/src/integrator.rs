@@ -77,6 +77,7 @@ pub fn render(
 }
 
 /// [`render`] with a given sampler, monomorphized so that no sample is a dynamic call.
+/// The scene's [`crate::desc::Isa`] chooses the compiled copy of the render loop.
 pub fn render_with<S: Sampler>(
     scene: &Scene,
     sampler: S,
@@ -85,6 +86,11 @@ pub fn render_with<S: Sampler>(
     progress: &(dyn Fn(u64) + Sync),
 ) -> RenderResult {
     let (w, h) = (scene.settings.width, scene.settings.height);
+    let isa = scene.settings.isa.resolve();
+    assert!(
+        isa.is_supported(),
+        "{isa:?} render loop on a CPU without it"
+    );
     let mut film = Film::new(w, h);
     let spp = samples.len() as u32;
     let pass_spp = (spp / 16).clamp(1, 8);
@@ -101,9 +107,20 @@ pub fn render_with<S: Sampler>(
                     return RenderStats::default();
                 }
                 let mut sampler = sampler.clone();
-                let y0 = (band * BAND_ROWS) as u32;
-                let s = render_pixels(scene, &mut sampler, pixels, w, y0, pass.clone());
-                progress(pixels.len() as u64 * pass.len() as u64);
+                let done = pixels.len() as u64 * pass.len() as u64;
+                let band = Band {
+                    pixels,
+                    width: w,
+                    y0: (band * BAND_ROWS) as u32,
+                    pass: pass.clone(),
+                };
+                let s = match isa {
+                    // SAFETY: the assertion above checked that the CPU has x86-64-v3.
+                    #[cfg(target_arch = "x86_64")]
+                    crate::desc::Isa::V3 => unsafe { render_pixels_v3(scene, &mut sampler, band) },
+                    _ => render_pixels(scene, &mut sampler, band),
+                };
+                progress(done);
                 s
             })
             .reduce(RenderStats::default, RenderStats::add);
@@ -118,14 +135,35 @@ pub fn render_with<S: Sampler>(
     }
 }
 
-fn render_pixels<S: Sampler>(
-    scene: &Scene,
-    sampler: &mut S,
-    pixels: &mut [Pixel],
+/// [`render_pixels`] compiled for x86-64-v3 (see [`crate::isa`]; the list is the one
+/// `Isa::is_supported` detects).
+#[cfg(target_arch = "x86_64")]
+#[target_feature(
+    enable = "avx,avx2,bmi1,bmi2,cmpxchg16b,f16c,fma,lzcnt,movbe,popcnt,sse3,sse4.1,sse4.2,ssse3,xsave"
+)]
+fn render_pixels_v3<S: Sampler>(scene: &Scene, sampler: &mut S, band: Band) -> RenderStats {
+    render_pixels(scene, sampler, band)
+}
+
+/// One work item: rows from `y0` of an image `width` pixels wide, and the sample indices
+/// to take in each of their pixels.
+struct Band<'a> {
+    pixels: &'a mut [Pixel],
     width: u32,
     y0: u32,
     pass: Range<u32>,
-) -> RenderStats {
+}
+
+/// Takes a band's samples; inlined into each copy of the render loop, so that it and
+/// its callees are compiled for each.
+#[inline(always)]
+fn render_pixels<S: Sampler>(scene: &Scene, sampler: &mut S, band: Band) -> RenderStats {
+    let Band {
+        pixels,
+        width,
+        y0,
+        pass,
+    } = band;
     let mut stats = RenderStats::default();
     for (i, pixel) in pixels.iter_mut().enumerate() {
         let p = UVec2::new(i as u32 % width, y0 + i as u32 / width);
@@ -160,6 +198,7 @@ fn mis_weight(mode: MisMode, pdf_f: f32, pdf_g: f32) -> f32 {
 }
 
 /// Radiance arriving along `ray`, estimated by one path.
+#[inline(always)]
 pub fn li<S: Sampler>(scene: &Scene, mut ray: Ray, sampler: &mut S, rays: &mut u64) -> Vec3 {
     let mode = scene.settings.mis;
     let mut l = Vec3::ZERO;
@@ -198,8 +237,10 @@ pub fn li<S: Sampler>(scene: &Scene, mut ray: Ray, sampler: &mut S, rays: &mut u
         // and their hashing (tens of cycles of dependent multiplies) then overlaps the
         // traversal instead of following it on the path's critical chain. The dimensions
         // are those of drawing them where they are used; a path that ends here wastes them.
-        let u =
-            (depth < scene.settings.max_depth).then(|| BounceSamples::<S>::draw(scene, sampler));
+        let u = (depth < scene.settings.max_depth).then(
+            #[inline(always)]
+            || BounceSamples::<S>::draw(scene, sampler),
+        );
         let hit = scene.intersect(&ray, f32::INFINITY);
         if depth == 0
             && scene.settings.hide_emitters

@@ -41,6 +41,7 @@ pub mod filter;
 pub mod geometry;
 pub mod instance;
 pub mod integrator;
+pub mod isa;
 pub mod light;
 pub mod light_sampler;
 pub mod material;
