@@ -184,6 +184,15 @@ pub fn prefetch(p: *const u8, lines: usize) {
     let _ = (p, lines);
 }
 
+/// Whether the ray's origin and direction are finite: `x - x` is zero for a finite `x`
+/// and NaN otherwise, so one sum tests all six (a third of the instructions of six
+/// `is_finite`s and no branches; callgrind, Cornell render).
+#[inline(always)]
+fn finite(ray: &Ray) -> bool {
+    let z = (ray.o - ray.o) + (ray.d - ray.d);
+    z.x + z.y + z.z == 0.0
+}
+
 impl WideBvh<Node8> {
     /// Collapses a binary tree: each wide node takes the binary node's two children and
     /// keeps opening its largest interior child (by surface area) until it has eight,
@@ -300,7 +309,7 @@ impl<N: WideNode> WideBvh<N> {
         mut leaf: impl FnMut(u32, u32, f32) -> f32,
         prefetch_leaf: impl Fn(u32),
     ) {
-        if self.nodes.is_empty() || !(ray.o.is_finite() && ray.d.is_finite()) {
+        if self.nodes.is_empty() || !finite(ray) {
             return;
         }
         let node_lines = size_of::<N>() / 64;
@@ -324,6 +333,39 @@ impl<N: WideNode> WideBvh<N> {
                     }
                     t_max = leaf(child[lane], prims, t_max);
                 }
+            } else if mask & (mask - 1) & (mask - 1).wrapping_sub(1) == 0 {
+                // Two children (the commonest case after one): the nearer is next, the
+                // farther waits. The order is the insertion's below (the higher lane
+                // first among equals), without its data-dependent branches and without
+                // the nearer's round trip through the stack (which, entered no farther
+                // than t_max, would pass the pop's test).
+                let (a, b) = (
+                    mask.trailing_zeros() as usize,
+                    31 - mask.leading_zeros() as usize,
+                );
+                let a_first = t_near[a] < t_near[b];
+                let (near, far) = if a_first { (a, b) } else { (b, a) };
+                let far = Entry {
+                    child: child[far],
+                    count: count[far] as u32,
+                    t: t_near[far],
+                };
+                if far.count == 0 {
+                    prefetch(
+                        self.nodes.as_ptr().wrapping_add(far.child as usize) as *const u8,
+                        node_lines,
+                    );
+                } else {
+                    prefetch_leaf(far.child);
+                }
+                stack[sp].write(far);
+                sp += 1;
+                let prims = count[near] as u32;
+                if prims == 0 {
+                    current = child[near] as usize;
+                    continue;
+                }
+                t_max = leaf(child[near], prims, t_max);
             } else {
                 // Push the hit children farthest first so that the nearest is popped next.
                 let base = sp;
@@ -390,7 +432,7 @@ impl<N: WideNode> WideBvh<N> {
         t_max: f32,
         mut leaf: impl FnMut(u32, u32, f32) -> bool,
     ) -> bool {
-        if self.nodes.is_empty() || !(ray.o.is_finite() && ray.d.is_finite()) {
+        if self.nodes.is_empty() || !finite(ray) {
             return false;
         }
         let node_lines = size_of::<N>() / 64;
