@@ -318,6 +318,18 @@ impl<N: WideNode> WideBvh<N> {
         let mut stack = [const { MaybeUninit::<Entry>::uninit() }; STACK];
         let mut sp = 0;
         let mut current = 0usize;
+        // A subtree put off for later: have its memory on the way meanwhile (measured:
+        // about 10 % more closest-hit rays/s on the room).
+        let wait = |e: &Entry| {
+            if e.count == 0 {
+                prefetch(
+                    self.nodes.as_ptr().wrapping_add(e.child as usize) as *const u8,
+                    node_lines,
+                );
+            } else {
+                prefetch_leaf(e.child);
+            }
+        };
         loop {
             let node = &self.nodes[current];
             let (mut mask, t_near) = node.hit::<K>(&r, t_max * T_MAX_SCALE);
@@ -350,14 +362,7 @@ impl<N: WideNode> WideBvh<N> {
                     count: count[far] as u32,
                     t: t_near[far],
                 };
-                if far.count == 0 {
-                    prefetch(
-                        self.nodes.as_ptr().wrapping_add(far.child as usize) as *const u8,
-                        node_lines,
-                    );
-                } else {
-                    prefetch_leaf(far.child);
-                }
+                wait(&far);
                 stack[sp].write(far);
                 sp += 1;
                 let prims = count[near] as u32;
@@ -367,36 +372,28 @@ impl<N: WideNode> WideBvh<N> {
                 }
                 t_max = leaf(child[near], prims, t_max);
             } else {
-                // Push the hit children farthest first so that the nearest is popped next.
-                let base = sp;
+                // Three or more: each goes straight to its place, farthest lowest, from its
+                // rank among them (how many are farther, or as far and in a lower lane:
+                // the order an insertion in lane order makes), with no data-dependent
+                // branches (the insertion's compare mispredicted 0.5 times a closest-hit
+                // query on the Cornell render, callgrind's branch model).
+                let hits = mask;
                 while mask != 0 {
                     let lane = mask.trailing_zeros() as usize;
+                    let below = hits & ((1 << lane) - 1);
                     mask &= mask - 1;
+                    let t = t_near[lane];
+                    let (farther, level) = K::order(&t_near, t);
+                    let rank = (farther & hits).count_ones() + (level & below).count_ones();
                     let entry = Entry {
                         child: child[lane],
                         count: count[lane] as u32,
-                        t: t_near[lane],
+                        t,
                     };
-                    // It waits on the stack: have its memory on the way meanwhile
-                    // (measured: about 10 % more closest-hit rays/s on the room).
-                    if entry.count == 0 {
-                        prefetch(
-                            self.nodes.as_ptr().wrapping_add(entry.child as usize) as *const u8,
-                            node_lines,
-                        );
-                    } else {
-                        prefetch_leaf(entry.child);
-                    }
-                    // Insertion into the (at most eight) entries pushed for this node.
-                    let mut j = sp;
-                    // SAFETY: slots from `base` to `sp` were written for this node.
-                    while j > base && stack[j - 1].assume_init().t < entry.t {
-                        stack[j] = stack[j - 1];
-                        j -= 1;
-                    }
-                    stack[j].write(entry);
-                    sp += 1;
+                    wait(&entry);
+                    stack[sp + rank as usize].write(entry);
                 }
+                sp += hits.count_ones() as usize;
             }
             // Pop the nearest pending subtree still in front of the nearest hit.
             loop {
