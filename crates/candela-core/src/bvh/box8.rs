@@ -60,7 +60,7 @@ pub enum Simd {
     Scalar,
     /// 4-lane SSE (x86-64 baseline): eight boxes or triangles as two halves.
     Sse,
-    /// 8-lane AVX2 box and triangle tests (on CPUs that also have BMI1, BMI2, LZCNT and POPCNT).
+    /// 8-lane AVX2 box and triangle tests (on CPUs that also have BMI1, BMI2 and LZCNT).
     Avx2,
 }
 
@@ -70,10 +70,10 @@ impl Simd {
     pub fn best() -> Simd {
         #[cfg(target_arch = "x86_64")]
         {
-            // The AVX2 traversal is also compiled for BMI1, BMI2, LZCNT and POPCNT, which every
+            // The AVX2 traversal is also compiled for BMI1, BMI2 and LZCNT, which every
             // AVX2 CPU (Haswell, Zen and later) has; asked anyway, as a VM may hide them.
             use std::arch::is_x86_feature_detected as has;
-            if has!("avx2") && has!("bmi1") && has!("bmi2") && has!("lzcnt") && has!("popcnt") {
+            if has!("avx2") && has!("bmi1") && has!("bmi2") && has!("lzcnt") {
                 Simd::Avx2
             } else {
                 Simd::Sse

@@ -184,6 +184,24 @@ pub fn prefetch(p: *const u8, lines: usize) {
     let _ = (p, lines);
 }
 
+/// Set bits of an eight-bit mask, from a table: fewer instructions than `count_ones`
+/// without `popcnt` (the SSE traversal's; callgrind, room closest-hit instructions a
+/// ray: 2141 with the insertion, 2267 with `count_ones` ranks, 2188 with this), and
+/// with AVX2 as few as two `popcnt`s (1497 -> 1476).
+#[inline(always)]
+fn ones8(bits: u32) -> u32 {
+    const ONES: [u8; 256] = {
+        let mut t = [0u8; 256];
+        let mut i = 0;
+        while i < 256 {
+            t[i] = (i as u32).count_ones() as u8;
+            i += 1;
+        }
+        t
+    };
+    ONES[bits as usize & 255] as u32
+}
+
 /// Whether the ray's origin and direction are finite: `x - x` is zero for a finite `x`
 /// and NaN otherwise, so one sum tests all six (a third of the instructions of six
 /// `is_finite`s and no branches; callgrind, Cornell render).
@@ -384,7 +402,7 @@ impl<N: WideNode> WideBvh<N> {
                     mask &= mask - 1;
                     let t = t_near[lane];
                     let (farther, level) = K::order(&t_near, t);
-                    let rank = (farther & hits).count_ones() + (level & below).count_ones();
+                    let rank = ones8(farther & hits | level & below);
                     let entry = Entry {
                         child: child[lane],
                         count: count[lane] as u32,
@@ -393,7 +411,7 @@ impl<N: WideNode> WideBvh<N> {
                     wait(&entry);
                     stack[sp + rank as usize].write(entry);
                 }
-                sp += hits.count_ones() as usize;
+                sp += ones8(hits) as usize;
             }
             // Pop the nearest pending subtree still in front of the nearest hit.
             loop {
