@@ -363,7 +363,7 @@ impl<N: WideNode> WideBvh<N> {
                     }
                     t_max = leaf(child[lane], prims, t_max);
                 }
-            } else if mask & (mask - 1) & (mask - 1).wrapping_sub(1) == 0 {
+            } else if (mask & (mask - 1)).count_ones() == 1 {
                 // Two children (the commonest case after one): the nearer is next, the
                 // farther waits. The order is the insertion's below (the higher lane
                 // first among equals), without its data-dependent branches and without
