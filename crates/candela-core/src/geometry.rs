@@ -135,36 +135,27 @@ pub struct WatertightRay {
 impl WatertightRay {
     #[inline]
     pub fn new(ray: &Ray) -> WatertightRay {
-        let d = ray.d;
-        // `d.abs().max_position()`, and the other two axes in cyclic order, written out:
-        // once per traced ray, the index arithmetic and checks cost as much as a box test.
-        let a = d.abs();
-        let (mut kz, mut max) = (0, a.x);
-        if a.y > max {
-            (kz, max) = (1, a.y);
-        }
-        if a.z > max {
-            kz = 2;
-        }
-        let (x, y, z) = match kz {
-            0 => (d.y, d.z, d.x),
-            1 => (d.z, d.x, d.y),
-            _ => (d.x, d.y, d.z),
-        };
-        let (mut kx, mut ky) = ((kz + 1) % 3, (kz + 2) % 3);
-        let (mut dx, mut dy) = (x, y);
-        if z < 0.0 {
-            (kx, ky) = (ky, kx);
-            (dx, dy) = (dy, dx);
-        }
-        let sz = 1.0 / z;
+        let d = ray.d.to_array();
+        // `d.abs().max_position()` (the first of equals), and the other two axes in cyclic
+        // order, swapped where d[kz] < 0 to keep the winding: selects and table lookups,
+        // no branches. Random directions made the branches mispredict about once a ray
+        // (callgrind's branch model on the Cornell render: 0.8 of 3.9 mispredictions a
+        // closest-hit query, 0.5 of 1.5 a shadow ray).
+        let a = ray.d.abs();
+        let y_wins = a.y > a.x;
+        let max = if y_wins { a.y } else { a.x };
+        let kz = if a.z > max { 2 } else { y_wins as usize };
+        let flip = d[kz] < 0.0;
+        let next = [[1, 2], [2, 0], [0, 1]][kz];
+        let (kx, ky) = (next[flip as usize], next[!flip as usize]);
+        let sz = 1.0 / d[kz];
         let o = ray.o.to_array();
         WatertightRay {
             o: ray.o,
             kx,
             ky,
             kz,
-            shear: Vec3::new(dx * sz, dy * sz, sz),
+            shear: Vec3::new(d[kx] * sz, d[ky] * sz, sz),
             o_k: Vec3::new(o[kx], o[ky], o[kz]),
         }
     }
@@ -366,5 +357,42 @@ mod tests {
         // On the plane and inside the y slab: the NaN axis counts as inside.
         let on = Vec3::new(-12.0, 1.6, 1.796);
         assert_eq!(plane.hit(on, x, f32::INFINITY), Some(2.0));
+    }
+
+    /// The branch-free `WatertightRay::new` picks what the paper's construction does:
+    /// `kz` the first axis of the largest |d|, `kx`, `ky` the next two cyclically,
+    /// swapped where d[kz] < 0, and the same shear and origin bits. Directions include
+    /// ties between axes, ±0 components and negative ones.
+    #[test]
+    fn watertight_ray_axes_as_the_paper_picks_them() {
+        let mut rng = crate::sampler::Pcg32::new(5, 17);
+        let choices = [0.0, -0.0, 0.5, -0.5, 1.0, -1.0];
+        let mut ties = 0;
+        for k in 0..20000 {
+            let mut c = || {
+                if k % 2 == 0 {
+                    choices[rng.next_u32() as usize % choices.len()]
+                } else {
+                    2.0 * rng.uniform_f32() - 1.0
+                }
+            };
+            let d = Vec3::new(c(), c(), c());
+            let o = Vec3::new(c(), c(), c()) * 3.0;
+            let w = WatertightRay::new(&Ray::new(o, d));
+            let kz = d.abs().max_position();
+            let (mut kx, mut ky) = ((kz + 1) % 3, (kz + 2) % 3);
+            if d[kz] < 0.0 {
+                std::mem::swap(&mut kx, &mut ky);
+            }
+            let sz = 1.0 / d[kz];
+            let shear = Vec3::new(d[kx] * sz, d[ky] * sz, sz);
+            assert_eq!((w.kx, w.ky, w.kz), (kx, ky, kz), "{d:?}");
+            let bits = |v: Vec3| v.to_array().map(f32::to_bits);
+            assert_eq!(bits(w.shear), bits(shear), "{d:?}");
+            assert_eq!(bits(w.o_k), bits(Vec3::new(o[kx], o[ky], o[kz])), "{d:?}");
+            ties += (d.abs().max_element() == d.abs().min_element()) as u32;
+        }
+        // Six values a component on even trials: all three |d| equal in 1/9 of those.
+        assert!(ties > 500, "only {ties} ties");
     }
 }

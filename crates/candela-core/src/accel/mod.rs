@@ -233,9 +233,10 @@ impl Accel {
     }
 
     /// The traversal compiled with AVX2 enabled, so that its box and triangle kernels
-    /// inline.
+    /// inline, and with the bit-manipulation sets every AVX2 CPU has ([`Simd::best`]
+    /// checks them): `blsr`/`tzcnt`/`lzcnt` for the child masks, `shlx` for shifts.
     #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx2")]
+    #[target_feature(enable = "avx2,bmi1,bmi2,lzcnt")]
     unsafe fn intersect_avx2<F: Fn(u32, &TriangleHit) -> bool>(
         &self,
         ray: &Ray,
@@ -246,7 +247,7 @@ impl Accel {
     }
 
     #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx2")]
+    #[target_feature(enable = "avx2,bmi1,bmi2,lzcnt")]
     unsafe fn occluded_avx2<F: Fn(u32, &TriangleHit) -> bool>(
         &self,
         ray: &Ray,

@@ -60,7 +60,7 @@ pub enum Simd {
     Scalar,
     /// 4-lane SSE (x86-64 baseline): eight boxes or triangles as two halves.
     Sse,
-    /// 8-lane AVX2 box and triangle tests.
+    /// 8-lane AVX2 box and triangle tests (on CPUs that also have BMI1, BMI2 and LZCNT).
     Avx2,
 }
 
@@ -70,7 +70,10 @@ impl Simd {
     pub fn best() -> Simd {
         #[cfg(target_arch = "x86_64")]
         {
-            if std::arch::is_x86_feature_detected!("avx2") {
+            // The AVX2 traversal is also compiled for BMI1, BMI2 and LZCNT, which every
+            // AVX2 CPU (Haswell, Zen and later) has; asked anyway, as a VM may hide them.
+            use std::arch::is_x86_feature_detected as has;
+            if has!("avx2") && has!("bmi1") && has!("bmi2") && has!("lzcnt") {
                 Simd::Avx2
             } else {
                 Simd::Sse
@@ -121,6 +124,13 @@ pub trait BoxTest {
     /// # Safety
     /// As for [`BoxTest::prepare`].
     unsafe fn hit8q(ray: &Self::Prepared, boxes: &QBoxes8, t_max: f32) -> (u32, [f32; 8]);
+
+    /// Which lanes of `t` are greater than `x`, and which equal it (bit i for lane i):
+    /// the traversal's ranks of the children it enters.
+    ///
+    /// # Safety
+    /// As for [`BoxTest::prepare`].
+    unsafe fn order(t: &[f32; 8], x: f32) -> (u32, u32);
 }
 
 /// `maxps` semantics: the second operand when either is NaN.
@@ -162,6 +172,13 @@ impl BoxTest for ScalarBoxes {
     #[inline(always)]
     unsafe fn hit8q(ray: &Ray8, boxes: &QBoxes8, t_max: f32) -> (u32, [f32; 8]) {
         hit8_scalar(ray, &boxes.planes(), t_max)
+    }
+
+    #[inline(always)]
+    unsafe fn order(t: &[f32; 8], x: f32) -> (u32, u32) {
+        t.iter().enumerate().fold((0, 0), |(gt, eq), (j, &tj)| {
+            (gt | ((tj > x) as u32) << j, eq | ((tj == x) as u32) << j)
+        })
     }
 }
 
@@ -245,6 +262,17 @@ mod x86 {
                 )
             })
         }
+
+        #[inline(always)]
+        unsafe fn order(t: &[f32; 8], x: f32) -> (u32, u32) {
+            let x = _mm_set1_ps(x);
+            let (lo, hi) = (_mm_loadu_ps(t.as_ptr()), _mm_loadu_ps(t.as_ptr().add(4)));
+            let bits = |lo, hi| _mm_movemask_ps(lo) as u32 | (_mm_movemask_ps(hi) as u32) << 4;
+            (
+                bits(_mm_cmpgt_ps(lo, x), _mm_cmpgt_ps(hi, x)),
+                bits(_mm_cmpeq_ps(lo, x), _mm_cmpeq_ps(hi, x)),
+            )
+        }
     }
 
     /// The slab test in two halves; `plane(axis, row, half)` gives four lanes of plane
@@ -322,6 +350,16 @@ mod x86 {
                     _mm256_set1_ps(*boxes.origin.get_unchecked(axis)),
                 )
             })
+        }
+
+        #[inline]
+        #[target_feature(enable = "avx2")]
+        unsafe fn order(t: &[f32; 8], x: f32) -> (u32, u32) {
+            let (t, x) = (_mm256_loadu_ps(t.as_ptr()), _mm256_set1_ps(x));
+            (
+                _mm256_movemask_ps(_mm256_cmp_ps::<_CMP_GT_OQ>(t, x)) as u32,
+                _mm256_movemask_ps(_mm256_cmp_ps::<_CMP_EQ_OQ>(t, x)) as u32,
+            )
         }
     }
 
@@ -487,5 +525,42 @@ mod tests {
             hits += m0.count_ones();
         }
         assert!(hits > 10000, "only {hits} box hits");
+    }
+
+    /// `order` (the traversal's child ranks) of every kernel the CPU has: the lanes
+    /// greater than and equal to a value, on distances with many ties, ±0 and ∞.
+    #[test]
+    fn kernels_order_as_plain_comparisons() {
+        let mut rng = Pcg32::new(4, 4);
+        let values = [0.0, -0.0, 0.5, 1.0, 1.5, 2.0, f32::INFINITY];
+        let (mut greater, mut equal) = (0, 0);
+        for k in 0..5000 {
+            let t: [f32; 8] = std::array::from_fn(|_| values[rng.next_u32() as usize % 7]);
+            let x = if k % 2 == 0 { t[k % 8] } else { values[k % 7] };
+            let plain = (0..8).fold((0, 0), |(g, e), j| {
+                (g | ((t[j] > x) as u32) << j, e | ((t[j] == x) as u32) << j)
+            });
+            greater += plain.0.count_ones();
+            equal += plain.1.count_ones();
+            for simd in Simd::available() {
+                // SAFETY: `available` lists only kernels this CPU supports.
+                let got = unsafe {
+                    match simd {
+                        #[cfg(target_arch = "x86_64")]
+                        Simd::Sse => SseBoxes::order(&t, x),
+                        #[cfg(target_arch = "x86_64")]
+                        Simd::Avx2 => Avx2Boxes::order(&t, x),
+                        _ => ScalarBoxes::order(&t, x),
+                    }
+                };
+                assert_eq!(got, plain, "{simd:?}: {t:?} against {x}");
+            }
+        }
+        // Seven values: about 3/7 of the lanes are greater and 1/7 equal (more on the
+        // trials whose x is one of the lanes).
+        assert!(
+            greater > 10000 && equal > 5000,
+            "{greater} greater, {equal} equal"
+        );
     }
 }

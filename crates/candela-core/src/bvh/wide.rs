@@ -184,6 +184,33 @@ pub fn prefetch(p: *const u8, lines: usize) {
     let _ = (p, lines);
 }
 
+/// Set bits of an eight-bit mask, from a table: fewer instructions than `count_ones`
+/// without `popcnt` (the SSE traversal's; callgrind, room closest-hit instructions a
+/// ray: 2141 with the insertion, 2267 with `count_ones` ranks, 2188 with this), and
+/// with AVX2 as few as two `popcnt`s (1497 -> 1476).
+#[inline(always)]
+fn ones8(bits: u32) -> u32 {
+    const ONES: [u8; 256] = {
+        let mut t = [0u8; 256];
+        let mut i = 0;
+        while i < 256 {
+            t[i] = (i as u32).count_ones() as u8;
+            i += 1;
+        }
+        t
+    };
+    ONES[bits as usize & 255] as u32
+}
+
+/// Whether the ray's origin and direction are finite: `x · 0` is ±0 for a finite `x`
+/// and NaN otherwise, so one sum tests all six (a third of the instructions of six
+/// `is_finite`s and no branches; callgrind, Cornell render).
+#[inline(always)]
+fn finite(ray: &Ray) -> bool {
+    let z = ray.o * 0.0 + ray.d * 0.0;
+    z.x + z.y + z.z == 0.0
+}
+
 impl WideBvh<Node8> {
     /// Collapses a binary tree: each wide node takes the binary node's two children and
     /// keeps opening its largest interior child (by surface area) until it has eight,
@@ -300,7 +327,7 @@ impl<N: WideNode> WideBvh<N> {
         mut leaf: impl FnMut(u32, u32, f32) -> f32,
         prefetch_leaf: impl Fn(u32),
     ) {
-        if self.nodes.is_empty() || !(ray.o.is_finite() && ray.d.is_finite()) {
+        if self.nodes.is_empty() || !finite(ray) {
             return;
         }
         let node_lines = size_of::<N>() / 64;
@@ -309,6 +336,18 @@ impl<N: WideNode> WideBvh<N> {
         let mut stack = [const { MaybeUninit::<Entry>::uninit() }; STACK];
         let mut sp = 0;
         let mut current = 0usize;
+        // A subtree put off for later: have its memory on the way meanwhile (measured:
+        // about 10 % more closest-hit rays/s on the room).
+        let wait = |e: &Entry| {
+            if e.count == 0 {
+                prefetch(
+                    self.nodes.as_ptr().wrapping_add(e.child as usize) as *const u8,
+                    node_lines,
+                );
+            } else {
+                prefetch_leaf(e.child);
+            }
+        };
         loop {
             let node = &self.nodes[current];
             let (mut mask, t_near) = node.hit::<K>(&r, t_max * T_MAX_SCALE);
@@ -324,37 +363,55 @@ impl<N: WideNode> WideBvh<N> {
                     }
                     t_max = leaf(child[lane], prims, t_max);
                 }
+            } else if (mask & (mask - 1)).count_ones() == 1 {
+                // Two children (the commonest case after one): the nearer is next, the
+                // farther waits. The order is the insertion's below (the higher lane
+                // first among equals), without its data-dependent branches and without
+                // the nearer's round trip through the stack (which, entered no farther
+                // than t_max, would pass the pop's test).
+                let (a, b) = (
+                    mask.trailing_zeros() as usize,
+                    31 - mask.leading_zeros() as usize,
+                );
+                let a_first = t_near[a] < t_near[b];
+                let (near, far) = if a_first { (a, b) } else { (b, a) };
+                let far = Entry {
+                    child: child[far],
+                    count: count[far] as u32,
+                    t: t_near[far],
+                };
+                wait(&far);
+                stack[sp].write(far);
+                sp += 1;
+                let prims = count[near] as u32;
+                if prims == 0 {
+                    current = child[near] as usize;
+                    continue;
+                }
+                t_max = leaf(child[near], prims, t_max);
             } else {
-                // Push the hit children farthest first so that the nearest is popped next.
-                let base = sp;
+                // Three or more: each goes straight to its place, farthest lowest, from its
+                // rank among them (how many are farther, or as far and in a lower lane:
+                // the order an insertion in lane order makes), with no data-dependent
+                // branches (the insertion's compare mispredicted 0.5 times a closest-hit
+                // query on the Cornell render, callgrind's branch model).
+                let hits = mask;
                 while mask != 0 {
                     let lane = mask.trailing_zeros() as usize;
+                    let below = hits & ((1 << lane) - 1);
                     mask &= mask - 1;
+                    let t = t_near[lane];
+                    let (farther, level) = K::order(&t_near, t);
+                    let rank = ones8(farther & hits | level & below);
                     let entry = Entry {
                         child: child[lane],
                         count: count[lane] as u32,
-                        t: t_near[lane],
+                        t,
                     };
-                    // It waits on the stack: have its memory on the way meanwhile
-                    // (measured: about 10 % more closest-hit rays/s on the room).
-                    if entry.count == 0 {
-                        prefetch(
-                            self.nodes.as_ptr().wrapping_add(entry.child as usize) as *const u8,
-                            node_lines,
-                        );
-                    } else {
-                        prefetch_leaf(entry.child);
-                    }
-                    // Insertion into the (at most eight) entries pushed for this node.
-                    let mut j = sp;
-                    // SAFETY: slots from `base` to `sp` were written for this node.
-                    while j > base && stack[j - 1].assume_init().t < entry.t {
-                        stack[j] = stack[j - 1];
-                        j -= 1;
-                    }
-                    stack[j].write(entry);
-                    sp += 1;
+                    wait(&entry);
+                    stack[sp + rank as usize].write(entry);
                 }
+                sp += ones8(hits) as usize;
             }
             // Pop the nearest pending subtree still in front of the nearest hit.
             loop {
@@ -390,7 +447,7 @@ impl<N: WideNode> WideBvh<N> {
         t_max: f32,
         mut leaf: impl FnMut(u32, u32, f32) -> bool,
     ) -> bool {
-        if self.nodes.is_empty() || !(ray.o.is_finite() && ray.d.is_finite()) {
+        if self.nodes.is_empty() || !finite(ray) {
             return false;
         }
         let node_lines = size_of::<N>() / 64;
