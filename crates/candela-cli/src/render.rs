@@ -261,10 +261,10 @@ pub fn run(args: RenderArgs) -> Result<ExitCode, UserError> {
     let mut desc = args.load.load(&args.scene)?;
     args.apply_overrides(&mut desc);
     if !desc.render.isa.is_supported() {
-        return Err(UserError(format!(
-            "--isa {:?}: this CPU cannot run it",
-            desc.render.isa
-        )));
+        // Auto and baseline run anywhere: only v3 can be refused.
+        return Err(UserError(
+            "--isa v3: this CPU lacks x86-64-v3 (AVX2, FMA, BMI1/2, LZCNT, MOVBE, F16C)".into(),
+        ));
     }
     args.apply_environment(&mut desc)?;
     let built = Instant::now();
