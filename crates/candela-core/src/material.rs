@@ -78,14 +78,12 @@ impl Material {
     #[inline(always)]
     pub fn bsdf_at(&self, si: &SurfaceInteraction) -> Bsdf {
         if let Material::Diffuse {
-            albedo: Texture::Constant(albedo),
+            albedo: Texture::Constant(_),
         } = self
         {
-            // What `lobe` makes of it: the texture's value times the vertex colour.
-            let lobe = Lobe::Diffuse(Diffuse {
-                albedo: *albedo * si.color,
-            });
-            return Bsdf::new(si.ns, si.ng, lobe);
+            // `lobe` and the texture's `eval` inline here to the constant times the
+            // vertex colour.
+            return Bsdf::new(si.ns, si.ng, self.lobe(si.uv, si.color));
         }
         self.bsdf_at_general(si)
     }
