@@ -352,6 +352,12 @@ impl<N: WideNode> WideBvh<N> {
             let node = &self.nodes[current];
             let (mut mask, t_near) = node.hit::<K>(&r, t_max * T_MAX_SCALE);
             let (child, count, _) = node.links();
+            // Child `lane` as a pending subtree.
+            let entry = |lane: usize| Entry {
+                child: child[lane],
+                count: count[lane] as u32,
+                t: t_near[lane],
+            };
             if mask & mask.wrapping_sub(1) == 0 {
                 // One child or none: no sorting, and an interior child is next.
                 if mask != 0 {
@@ -375,11 +381,7 @@ impl<N: WideNode> WideBvh<N> {
                 );
                 let a_first = t_near[a] < t_near[b];
                 let (near, far) = if a_first { (a, b) } else { (b, a) };
-                let far = Entry {
-                    child: child[far],
-                    count: count[far] as u32,
-                    t: t_near[far],
-                };
+                let far = entry(far);
                 wait(&far);
                 stack[sp].write(far);
                 sp += 1;
@@ -403,11 +405,7 @@ impl<N: WideNode> WideBvh<N> {
                     let t = t_near[lane];
                     let (farther, level) = K::order(&t_near, t);
                     let rank = ones8(farther & hits | level & below);
-                    let entry = Entry {
-                        child: child[lane],
-                        count: count[lane] as u32,
-                        t,
-                    };
+                    let entry = entry(lane);
                     wait(&entry);
                     stack[sp + rank as usize].write(entry);
                 }
