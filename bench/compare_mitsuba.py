@@ -40,8 +40,14 @@ OUT = os.path.join(BENCH_DIR, "out", "compare")
 CANDELA = os.path.join(REPO, "target", "release", "candela")
 REF_SEED = 100_000  # far from the benchmark's seeds: independent noise
 REF_PASS_SPP = 64
-NAME = {"candela": "Candela", "llvm_ad_rgb": "Mitsuba 3 llvm_ad_rgb",
-        "scalar_rgb": "Mitsuba 3 scalar_rgb"}
+
+
+def peer_name(key: str) -> str:
+    """A row's name from its key: "candela", a Mitsuba variant, or VARIANT+SAMPLER."""
+    if key == "candela":
+        return "Candela"
+    variant, _, sampler = key.partition("+")
+    return f"Mitsuba 3 {variant}" + (f", {sampler} sampler" if sampler else "")
 
 
 def default_scenes() -> list:
@@ -162,23 +168,25 @@ def noise_floor(relmse_mitsuba: float, spp: int, ref_spp: int) -> float:
     return relmse_mitsuba * r / (1 + r)
 
 
-def measure_equal_time(scene: str, tag: str, params: dict, a, variants: list,
+def measure_equal_time(scene: str, tag: str, params: dict, a, peers: list,
                        runs: dict) -> dict:
-    """Checks the extrapolation: each Mitsuba variant renders once more with its spp
-    scaled so that it takes Candela's median time (variant → spp, seconds, image)."""
+    """Checks the extrapolation: each Mitsuba row renders once more with its spp scaled
+    so that it takes Candela's median time (key → spp, seconds, image)."""
     t_c = statistics.median(r["time_s"] for r in runs["candela"])
     found = {}
-    for v in variants:
-        t_v = statistics.median(r["warm_s"] or r["time_s"] for r in runs[v])
+    for key, v, sampler in peers:
+        t_v = statistics.median(r["warm_s"] or r["time_s"] for r in runs[key])
         spp = max(1, round(a.spp * t_c / t_v))
-        print(f"[compare] {tag}: mitsuba {v} at Candela's time: {spp} spp", flush=True)
-        out = os.path.join(OUT, f"{tag}_{v}_equal_time.exr")
+        if sampler in ("multijitter", "stratified"):
+            spp = max(1, round(spp ** 0.5)) ** 2  # what Mitsuba would round it up to
+        print(f"[compare] {tag}: mitsuba {key} at Candela's time: {spp} spp", flush=True)
+        out = os.path.join(OUT, f"{tag}_{key}_equal_time.exr")
         r = mitsuba_render.run(scene, out, variant=v, threads=a.threads,
                                params=dict(params, **({"spp": spp} if "spp" in params else {})),
                                seed=1000, render_spp=spp,
-                               warm_runs=1 if v.startswith("llvm") else 0)
+                               warm_runs=1 if v.startswith("llvm") else 0, sampler=sampler)
         time_s = r["warm"][0]["wall_s"] if r["warm"] else r["renders"][0]["wall_s"]
-        found[v] = {"spp": spp, "time_s": time_s, "out": out}
+        found[key] = {"spp": spp, "time_s": time_s, "out": out}
     return found
 
 
@@ -199,31 +207,35 @@ def run_candela(scene: str, out: str, params: dict, a, seed: int) -> dict:
             "out": out, "command": " ".join(cmd), "warnings": p.stderr.count("warning")}
 
 
-def compare(scene: str, a, variants: list) -> str:
+def compare(scene: str, a, peers: list) -> str:
+    """One scene's table; `peers` are the Mitsuba rows, (key, variant, sampler or None
+    for the file's)."""
     tag = os.path.basename(os.path.dirname(scene)) if scene.endswith("scene.xml") \
         else os.path.splitext(os.path.basename(scene))[0]
     source = scene
     params = scene_params(scene, a.spp, a.res)
     scene = prepare(scene, tag, a)
+    variants = [v for _, v, _ in peers]
     ref_variant = "llvm_ad_rgb" if "llvm_ad_rgb" in variants else "scalar_rgb"
     ref_path = given_reference(a, source) if a.reference else \
         reference(scene, tag, params, a, ref_variant, source)
-    runs = {k: [] for k in ["candela"] + variants}
+    keys = [key for key, _, _ in peers]
+    runs = {k: [] for k in ["candela"] + keys}
     for rep in range(a.repeats):
         out = os.path.join(OUT, f"{tag}_candela_{rep}.exr")
         print(f"[compare] {tag} run {rep + 1}/{a.repeats}: candela", flush=True)
         runs["candela"].append(run_candela(scene, out, params, a, rep))
-        for v in variants:
-            print(f"[compare] {tag} run {rep + 1}/{a.repeats}: mitsuba {v}", flush=True)
-            out = os.path.join(OUT, f"{tag}_{v}_{rep}.exr")
+        for key, v, sampler in peers:
+            print(f"[compare] {tag} run {rep + 1}/{a.repeats}: mitsuba {key}", flush=True)
+            out = os.path.join(OUT, f"{tag}_{key}_{rep}.exr")
             r = mitsuba_render.run(scene, out, variant=v, threads=a.threads, params=params,
                                    seed=rep, render_spp=a.spp,
                                    warm_runs=1 if v.startswith("llvm") else 0,
-                                   cold_kernel_cache=v.startswith("llvm"))
+                                   cold_kernel_cache=v.startswith("llvm"), sampler=sampler)
             warm = r["warm"][0]["wall_s"] if r["warm"] else None
-            runs[v].append({"time_s": r["renders"][0]["wall_s"], "warm_s": warm,
+            runs[key].append({"time_s": r["renders"][0]["wall_s"], "warm_s": warm,
                             "cpu_s": r["renders"][0]["cpu_s"], "out": out})
-    equal_time = measure_equal_time(scene, tag, params, a, variants, runs) \
+    equal_time = measure_equal_time(scene, tag, params, a, peers, runs) \
         if a.measure_equal_time else {}
 
     import mitsuba as mi  # EXR I/O only
@@ -245,20 +257,23 @@ def compare(scene: str, a, variants: list) -> str:
                       "t_cold": statistics.median(r["time_s"] for r in rs),
                       "relmse": statistics.mean(images.relmse(x, ref) for x in imgs),
                       "z": images.mean_difference_z(imgs[0], ref)}
+    # The reference samples as the file says: its noise is estimated from the rows that
+    # do too.
+    same_sampler = [key for key, _, sampler in peers if sampler is None]
     floor = 0.0
-    if not a.reference and variants:
-        floor = noise_floor(statistics.mean(stats[v]["relmse"] for v in variants), a.spp,
+    if not a.reference and same_sampler:
+        floor = noise_floor(statistics.mean(stats[k]["relmse"] for k in same_sampler), a.spp,
                             max(1, a.ref_spp // REF_PASS_SPP) * REF_PASS_SPP)
     for s in stats.values():
         s["net"] = max(s["relmse"] - floor, 1e-12)
     c = stats["candela"]
     rows = []
-    for key in ["candela"] + variants:
+    for key in ["candela"] + keys:
         s = stats[key]
         at_candela_time = s["net"] * s["t"] / c["t"]
         to_candela_error = s["t"] * s["net"] / c["net"]
         candela_to_this = c["t"] * c["net"] / s["net"]
-        rows.append([NAME[key], report.fmt(s["t"]), report.fmt(s["t_cold"]),
+        rows.append([peer_name(key), report.fmt(s["t"]), report.fmt(s["t_cold"]),
                      f"{s['relmse']:.5f}", f"{s['net']:.5f}", f"{at_candela_time:.5f}",
                      report.fmt(to_candela_error),
                      "—" if key == "candela" else report.fmt(candela_to_this),
@@ -268,7 +283,7 @@ def compare(scene: str, a, variants: list) -> str:
     measured = []
     for v, e in equal_time.items():
         m = images.relmse(images.load_exr(e["out"]), ref) - floor
-        measured.append(f"{NAME[v]} at {e['spp']} spp took {e['time_s']:.2f} s (Candela "
+        measured.append(f"{peer_name(v)} at {e['spp']} spp took {e['time_s']:.2f} s (Candela "
                         f"{c['t']:.2f} s): relMSE − ref noise {m:.5f}, extrapolated "
                         f"{stats[v]['net'] * stats[v]['t'] / c['t']:.5f}")
     defines = " ".join(f"-D {k}={v}" for k, v in params.items())
@@ -310,8 +325,11 @@ def main() -> None:
                     "(default); file: the file's own filter")
     ap.add_argument("--variants", default="llvm_ad_rgb,scalar_rgb")
     ap.add_argument("--skip-build", action="store_true")
-    ap.add_argument("--sampler", choices=["independent", "sobol"],
+    ap.add_argument("--sampler",
                     help="Candela's --sampler (default: what the XML's <sampler> maps to)")
+    ap.add_argument("--mitsuba-stratified", default="llvm_ad_rgb:multijitter",
+                    help="extra Mitsuba rows as VARIANT:SAMPLER[,...], the file's <sampler> "
+                    "replaced by that type (e.g. multijitter); '' for none")
     ap.add_argument("--measure-equal-time", action="store_true",
                     help="also render each Mitsuba variant once at the spp that takes "
                     "Candela's time, to check the extrapolated equal-time relMSE")
@@ -319,9 +337,14 @@ def main() -> None:
                     help="where the markdown is written besides stdout")
     a = ap.parse_args()
     variants = [v for v in a.variants.split(",") if v]
-    if "llvm_ad_rgb" in variants and mitsuba_render.libllvm_path() is None:
-        print("[compare] no libLLVM (run bench/setup.sh): skipping llvm_ad_rgb", flush=True)
-        variants.remove("llvm_ad_rgb")
+    extra = [tuple(x.split(":", 1)) for x in a.mitsuba_stratified.split(",") if x]
+    if mitsuba_render.libllvm_path() is None:
+        if "llvm_ad_rgb" in variants:
+            print("[compare] no libLLVM (run bench/setup.sh): skipping llvm_ad_rgb",
+                  flush=True)
+            variants.remove("llvm_ad_rgb")
+        extra = [(v, s) for v, s in extra if not v.startswith("llvm")]
+    peers = [(v, v, None) for v in variants] + [(f"{v}+{s}", v, s) for v, s in extra]
     os.makedirs(OUT, exist_ok=True)
     if not a.skip_build:
         subprocess.run(["cargo", "build", "--release", "-p", "candela-cli"], cwd=REPO,
@@ -333,7 +356,7 @@ def main() -> None:
              f"Command: `bench/compare_mitsuba {' '.join(sys.argv[1:])}`", ""]
     for scene in scenes:
         try:
-            parts.append(compare(scene, a, variants))
+            parts.append(compare(scene, a, peers))
         except Exception as e:  # one scene failing must not lose the others' figures
             print(f"[compare] {scene} failed: {e}", flush=True)
             parts += [f"#### `{os.path.relpath(scene, REPO)}`: not compared: "
@@ -345,7 +368,10 @@ def main() -> None:
         f"(x − ref)²/(ref² + {images.RELMSE_EPS}), reference noise included; *relMSE − "
         "ref noise* subtracts the reference's own noise, estimated from the Mitsuba runs "
         "as relMSE·r/(1 + r), r = spp/ref_spp (same estimator as the reference), and is "
-        "what the next columns use. Extrapolated with relMSE ∝ 1/time, not measured: "
+        "what the next columns use. Extrapolated with relMSE ∝ 1/time, not measured "
+        "(exact in expectation for independent samples; a stratified sampler's relMSE "
+        "falls faster, so where its error is below Candela's the extrapolation favours "
+        "it): "
         "*relMSE at Candela's time* = relMSE · t / t_Candela; *s to Candela's error* = "
         "t · relMSE / relMSE_Candela; *efficiency ÷ Candela's* = (relMSE · t) / "
         "(relMSE_Candela · t_Candela): above 1, Candela reaches equal error sooner. "

@@ -84,20 +84,28 @@ def main() -> None:
     ap.add_argument("--ref-spp", type=int, default=1024)
     ap.add_argument("--variants", default="llvm_ad_rgb,scalar_rgb")
     ap.add_argument("--skip-build", action="store_true")
-    ap.add_argument("--sampler", choices=["independent", "sobol"],
+    ap.add_argument("--sampler",
                     help="Candela's --sampler (default: the scene's, i.e. Candela's default)")
+    ap.add_argument("--mitsuba-stratified", default="llvm_ad_rgb:multijitter",
+                    help="extra Mitsuba rows as VARIANT:SAMPLER[,...] (a Mitsuba sampler "
+                         "other than the scene's independent one); '' for none")
     a = ap.parse_args()
     variants = [v for v in a.variants.split(",") if v]
-    if "llvm_ad_rgb" in variants and mitsuba_render.libllvm_path() is None:
-        print("[cornell] no libLLVM (run bench/setup.sh): skipping llvm_ad_rgb", flush=True)
-        variants.remove("llvm_ad_rgb")
+    extra = [tuple(x.split(":", 1)) for x in a.mitsuba_stratified.split(",") if x]
+    if mitsuba_render.libllvm_path() is None:
+        if "llvm_ad_rgb" in variants:
+            print("[cornell] no libLLVM (run bench/setup.sh): skipping llvm_ad_rgb", flush=True)
+            variants.remove("llvm_ad_rgb")
+        extra = [(v, s) for v, s in extra if not v.startswith("llvm")]
+    # A peer row: its key, Mitsuba variant and Mitsuba sampler (None: the scene's).
+    peers = [(v, v, None) for v in variants] + [(f"{v}+{s}", v, s) for v, s in extra]
     os.makedirs(OUT, exist_ok=True)
     if not a.skip_build:
         build_candela()
 
     ref_path, ref_meta = reference(a, variants)
     res = (a.res, a.res)
-    runs = {"candela": []} | {v: [] for v in variants}
+    runs = {"candela": []} | {key: [] for key, _, _ in peers}
     for rep in range(a.repeats):
         # Interleaved so that a burst of load from elsewhere hits every renderer alike.
         out = os.path.join(OUT, f"candela_{rep}.exr")
@@ -105,18 +113,18 @@ def main() -> None:
         runs["candela"].append(candela.render(
             CANDELA, SCENE_TOML, out, spp=a.spp, max_depth=a.max_depth, threads=a.threads,
             res=res, seed=rep, cwd=REPO, sampler=a.sampler).__dict__ | {"out": out})
-        for v in variants:
-            print(f"[cornell] run {rep + 1}/{a.repeats}: mitsuba {v}", flush=True)
-            out = os.path.join(OUT, f"mitsuba_{v}_{rep}.exr")
-            runs[v].append(mitsuba_render.run(
+        for key, v, sampler in peers:
+            print(f"[cornell] run {rep + 1}/{a.repeats}: mitsuba {key}", flush=True)
+            out = os.path.join(OUT, f"mitsuba_{key}_{rep}.exr")
+            runs[key].append(mitsuba_render.run(
                 SCENE_XML, out, variant=v, threads=a.threads, spp=a.spp,
                 max_depth=a.max_depth + 1, res=a.res, seed=rep, warm_runs=1,
-                cold_kernel_cache=v.startswith("llvm")))
+                cold_kernel_cache=v.startswith("llvm"), sampler=sampler))
 
     import mitsuba as mi  # for EXR I/O only
     mi.set_variant("scalar_rgb")
     ref = images.load_exr(ref_path)
-    md = render_report(a, variants, runs, ref, ref_meta)
+    md = render_report(a, peers, runs, ref, ref_meta)
     print()
     print(md)
     with open(os.path.join(OUT, "cornell.md"), "w") as f:
@@ -127,14 +135,18 @@ def main() -> None:
     print("\n[cornell] wrote bench/out/cornell.md and bench/out/cornell.json")
 
 
-def render_report(a, variants, runs, ref, ref_meta) -> str:
+def render_report(a, peers, runs, ref, ref_meta) -> str:
     pixels = a.res * a.res * a.spp
-    name = {"candela": "Candela", "llvm_ad_rgb": "Mitsuba 3 llvm_ad_rgb",
-            "scalar_rgb": "Mitsuba 3 scalar_rgb"}
+    name = {"candela": "Candela"} | {
+        key: f"Mitsuba 3 {v}" + (f", {s} sampler" if s else "") for key, v, s in peers}
+    keys = [key for key, _, _ in peers]
+    # The reference is rendered with the scene's independent sampler: its noise share is
+    # estimated from the rows that sample as it does.
+    independent_keys = [key for key, _, s in peers if s is None]
     t_candela = statistics.median(r["render_s"] for r in runs["candela"])
     rows, stat_rows, side_rows, first_images = [], [], [], {}
     equal_error = {}  # key -> (time used, relMSE)
-    for key in ["candela"] + variants:
+    for key in ["candela"] + keys:
         rs = runs[key]
         if key == "candela":
             times = [r["render_s"] for r in rs]
@@ -172,7 +184,7 @@ def render_report(a, variants, runs, ref, ref_meta) -> str:
     stat_rows.append([f"reference ({ref_meta['spp']} spp {ref_meta['variant']})",
                       report.fmt_rgb(images.mean_rgb(ref)), "—", "—"])
     cross = []
-    for v in variants:
+    for v in keys:
         z = images.mean_difference_z(first_images["candela"], first_images[v])
         cross.append([f"Candela − {name[v]}", report.fmt_rgb(z, 2),
                       "yes" if max(abs(z)) < images.Z_CRIT else "**NO**"])
@@ -182,12 +194,12 @@ def render_report(a, variants, runs, ref, ref_meta) -> str:
     # off. Each Mitsuba variant's time to Candela's error follows from its independent
     # samples, whose relMSE falls exactly as 1/time in expectation: t·relMSE/relMSE_C.
     r = a.spp / ref_meta["spp"]
-    mitsuba_relmse = [equal_error[v][1] for v in variants]
-    ref_noise = statistics.median(mitsuba_relmse) * r / (1 + r) if variants else 0.0
+    mitsuba_relmse = [equal_error[v][1] for v in independent_keys]
+    ref_noise = statistics.median(mitsuba_relmse) * r / (1 + r) if mitsuba_relmse else 0.0
     t_c, e_c = equal_error["candela"]
     e_c_net = max(e_c - ref_noise, 1e-12)
     ee_rows = []
-    for key in ["candela"] + variants:
+    for key in ["candela"] + keys:
         t, e = equal_error[key]
         e_net = max(e - ref_noise, 1e-12)
         t_eq = t * e_net / e_c_net
@@ -195,7 +207,7 @@ def render_report(a, variants, runs, ref, ref_meta) -> str:
                         report.fmt(t_eq), report.fmt(t_eq / t_c)])
 
     m = machine.describe(REPO)
-    mi_run = runs[variants[0]][0] if variants else None
+    mi_run = runs[keys[0]][0] if keys else None
     lines = [
         f"### Cornell box, {a.res}×{a.res}, {a.spp} spp, max depth {a.max_depth} "
         f"(Mitsuba max_depth {a.max_depth + 1}), {a.threads} threads",
@@ -233,7 +245,10 @@ def render_report(a, variants, runs, ref, ref_meta) -> str:
         f"compiled). *relMSE − ref noise*: minus {ref_noise:.2e}, the share of the "
         f"{ref_meta['spp']}-spp Mitsuba reference's own noise (Mitsuba relMSE × r/(1 + r), "
         f"r = {r:.3g}). *s to Candela's error* = time × net relMSE ÷ Candela's net relMSE: "
-        "exact in expectation for Mitsuba's independent samples (relMSE ∝ 1/time); "
+        "exact in expectation for Mitsuba's independent samples (relMSE ∝ 1/time). "
+        "For a stratified sampler relMSE falls faster than 1/time, so where its error is "
+        "below Candela's the true time to Candela's error is longer than this figure: the "
+        "ratio is then a bound that favours Mitsuba. "
         "*÷ Candela's time* above 1 means Candela reaches that error sooner.",
         "",
         "Mean radiance (first run's image) and z of the mean pixel difference against the "
@@ -252,8 +267,8 @@ def render_report(a, variants, runs, ref, ref_meta) -> str:
         " ".join(os.path.relpath(c, REPO) if c.startswith(REPO) else c
                  for c in runs["candela"][0]["command"]),
     ]
-    for v in variants:
-        cmd = runs[v][0]["command"]
+    for key, v, _ in peers:
+        cmd = runs[key][0]["command"]
         lines.append("(cd bench && " + ("DRJIT_LIBLLVM_PATH=… " if v.startswith("llvm") else "")
                      + " ".join(os.path.relpath(c, BENCH_DIR) if c.startswith(BENCH_DIR) else c
                                 for c in cmd) + ")")

@@ -15,6 +15,7 @@ mean (how a high-spp reference is built without one huge LLVM wavefront).
 import argparse
 import json
 import os
+import re
 import resource
 import subprocess
 import sys
@@ -42,13 +43,14 @@ def libllvm_path() -> Optional[str]:
 def run(scene: str, out: str, *, variant: str, threads: int, spp: int = 0,
         max_depth: int = 0, res: int = 0, params: Optional[dict] = None, seed: int = 0,
         passes: int = 1, warm_runs: int = 0, cold_kernel_cache: bool = False,
-        render_spp: int = 0, timeout_s: float = 3600) -> dict:
+        render_spp: int = 0, sampler: Optional[str] = None, timeout_s: float = 3600) -> dict:
     """Render in a child process and return its JSON report (see `_child`).
 
     The scene's parameters are `params` (name → value, as `-D` gives them) when given,
     otherwise `spp`, `max_depth` and `res` (the benchmark scenes' parameters).
     `render_spp` > 0 overrides the scene's sample count in `mi.render` (for scenes
-    without an `$spp` parameter).
+    without an `$spp` parameter). `sampler` replaces the type of the scene's one
+    `<sampler>` (e.g. "multijitter"), keeping its parameters.
     `cold_kernel_cache` points Dr.Jit's on-disk kernel cache (~/.drjit) at an empty
     directory, so that the first render really compiles its kernels."""
     if params is None:
@@ -63,7 +65,7 @@ def run(scene: str, out: str, *, variant: str, threads: int, spp: int = 0,
            "--variant", variant, "--threads", str(threads), "--params", json.dumps(params),
            "--seed", str(seed),
            "--passes", str(passes), "--warm-runs", str(warm_runs),
-           "--spp", str(render_spp)]
+           "--spp", str(render_spp)] + (["--sampler", sampler] if sampler else [])
     with tempfile.TemporaryDirectory(prefix="drjit-home-") as home:
         if cold_kernel_cache:
             env["HOME"] = home
@@ -73,7 +75,9 @@ def run(scene: str, out: str, *, variant: str, threads: int, spp: int = 0,
         process_s = time.perf_counter() - t0
     if p.returncode != 0:
         raise RuntimeError(f"{' '.join(cmd)} failed ({p.returncode}):\n{p.stderr}{p.stdout}")
-    report = json.loads(p.stdout.strip().splitlines()[-1])
+    # Mitsuba's log may leave a colour reset code before the report on its line.
+    last = p.stdout.strip().splitlines()[-1]
+    report = json.loads(last[last.find("{"):])
     report["process_s"] = process_s
     report["command"] = cmd
     return report
@@ -89,6 +93,20 @@ def _os_threads() -> int:
         return len(os.listdir("/proc/self/task"))
     except OSError:
         return -1
+
+
+def _with_sampler(path: str, sampler: str) -> str:
+    """The scene file's text with its one `<sampler type="...">` set to `sampler`; the
+    file's directory goes first on Mitsuba's file resolver, so relative paths in the text
+    resolve as in the file."""
+    import mitsuba as mi
+
+    with open(path) as f:
+        text, n = re.subn(r'(<sampler\s+type=")[^"]*(")', rf"\g<1>{sampler}\g<2>", f.read())
+    if n != 1:
+        raise SystemExit(f"{path}: expected one <sampler type=...>, found {n}")
+    mi.file_resolver().prepend(os.path.dirname(os.path.abspath(path)))
+    return text
 
 
 def _child(a: argparse.Namespace) -> dict:
@@ -107,7 +125,11 @@ def _child(a: argparse.Namespace) -> dict:
 
     t0 = time.perf_counter()
     params = json.loads(a.params)
-    scene = mi.load_file(a.scene, **{k: str(v) for k, v in params.items()})
+    params = {k: str(v) for k, v in params.items()}
+    if a.sampler:
+        scene = mi.load_string(_with_sampler(a.scene, a.sampler), **params)
+    else:
+        scene = mi.load_file(a.scene, **params)
     load_s = time.perf_counter() - t0
 
     def timed_render(seed: int):
@@ -155,6 +177,7 @@ def main() -> None:
     ap.add_argument("--warm-runs", type=int, default=0)
     ap.add_argument("--spp", type=int, default=0,
                     help="samples per pixel for mi.render (0: the scene's sample_count)")
+    ap.add_argument("--sampler", help="replace the scene's sampler type (e.g. multijitter)")
     report = _child(ap.parse_args())
     sys.stdout.flush()
     print(json.dumps(report), flush=True)
