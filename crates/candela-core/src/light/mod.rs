@@ -98,7 +98,10 @@ impl LightSample {
     /// [`Light::sample_li`] applies to every light's sample.
     #[inline(always)]
     pub fn usable(self) -> Option<LightSample> {
-        (self.pdf > 0.0 && self.pdf.is_finite() && self.radiance != Vec3::ZERO).then_some(self)
+        // `0 < pdf < ∞` is `pdf > 0 && pdf.is_finite()` (NaN fails both) in two float
+        // compares; `is_finite` became a dozen integer instructions on the bits.
+        (self.pdf > 0.0 && self.pdf < f32::INFINITY && self.radiance != Vec3::ZERO)
+            .then_some(self)
     }
 
     /// The sample of point `p`, drawn uniformly by area on a flat one-sided emitter of
