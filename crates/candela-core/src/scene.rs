@@ -164,7 +164,10 @@ impl SurfaceInteraction {
     /// A ray leaving this surface towards `d`, its origin moved off the surface.
     #[inline]
     pub fn spawn_ray(&self, d: Vec3) -> Ray {
-        Ray::new(offset_ray_origin(self.p, negated_unless(self.ng, d.dot(self.ng) >= 0.0)), d)
+        Ray::new(
+            offset_ray_origin(self.p, negated_unless(self.ng, d.dot(self.ng) >= 0.0)),
+            d,
+        )
     }
 }
 
