@@ -164,13 +164,20 @@ impl SurfaceInteraction {
     /// A ray leaving this surface towards `d`, its origin moved off the surface.
     #[inline]
     pub fn spawn_ray(&self, d: Vec3) -> Ray {
-        let n = if d.dot(self.ng) >= 0.0 {
-            self.ng
-        } else {
-            -self.ng
-        };
-        Ray::new(offset_ray_origin(self.p, n), d)
+        Ray::new(
+            offset_ray_origin(self.p, negated_unless(self.ng, d.dot(self.ng) >= 0.0)),
+            d,
+        )
     }
+}
+
+/// `n` where `keep`, else `−n`: as a product with ±1 (exact, so bit for bit the select)
+/// rather than a select of vectors, which LLVM built from a broadcast comparison mask, a
+/// dozen instructions where this takes a few; it turns a ray's offset normal towards the
+/// side it leaves, three times a bounce.
+#[inline(always)]
+fn negated_unless(n: Vec3, keep: bool) -> Vec3 {
+    n * if keep { 1.0 } else { -1.0 }
 }
 
 /// The scene as the integrator sees it. Made by [`crate::build::build`].
@@ -270,22 +277,17 @@ impl Scene {
     #[inline]
     pub fn unoccluded(&self, from: Vec3, n_from: Vec3, to: Vec3, n_to: Vec3) -> bool {
         let d = to - from;
-        let o = offset_ray_origin(
-            from,
-            if d.dot(n_from) >= 0.0 {
-                n_from
-            } else {
-                -n_from
-            },
-        );
+        let o = offset_ray_origin(from, negated_unless(n_from, d.dot(n_from) >= 0.0));
         let target = if n_to == Vec3::ZERO {
             to
         } else {
-            offset_ray_origin(to, if d.dot(n_to) <= 0.0 { n_to } else { -n_to })
+            offset_ray_origin(to, negated_unless(n_to, d.dot(n_to) <= 0.0))
         };
         let d = target - o;
         let dist = d.length();
-        if dist == 0.0 || !dist.is_finite() {
+        // Not 0 < dist < ∞ (NaN included): two compares, where `is_finite` was a dozen
+        // integer instructions on the bits.
+        if !(dist > 0.0 && dist < f32::INFINITY) {
             return dist == 0.0;
         }
         // A relative margin keeps the far end from blocking itself.
@@ -295,14 +297,7 @@ impl Scene {
     /// Whether a ray leaving `from` towards `d` escapes the scene.
     #[inline]
     pub fn escapes(&self, from: Vec3, n_from: Vec3, d: Vec3) -> bool {
-        let o = offset_ray_origin(
-            from,
-            if d.dot(n_from) >= 0.0 {
-                n_from
-            } else {
-                -n_from
-            },
-        );
+        let o = offset_ray_origin(from, negated_unless(n_from, d.dot(n_from) >= 0.0));
         !self.occluded(&Ray::new(o, d), f32::INFINITY)
     }
 

@@ -41,6 +41,9 @@ pub struct LightPick {
 pub enum LightSampler {
     /// No lights to sample.
     Empty,
+    /// The one light there is, picked with probability 1: what the uniform, power and
+    /// array samplers give for one light, without their arithmetic.
+    Single,
     /// Every light equally likely.
     Uniform { count: u32 },
     /// Proportional to each light's power Φ, in O(1) through an alias table.
@@ -64,10 +67,18 @@ impl LightSampler {
             count: lights.len() as u32,
         };
         let powers = || -> Vec<f32> { lights.iter().map(Light::power).collect() };
-        // One light: the alias table and the array pick it with probability exactly 1, as
-        // the uniform sampler does in fewer instructions (5% of the Cornell box's NEE).
-        if lights.len() == 1 && matches!(kind, LightSamplerKind::Power | LightSamplerKind::Array) {
-            return uniform;
+        // One light: the uniform sampler, the alias table and the array pick it with
+        // probability exactly 1, which needs no arithmetic (the uniform pick's saturating
+        // float-to-integer conversion and division were 23 of the Cornell box's ~320
+        // instructions a light sample). The BVH and RIS can still refuse a light that
+        // cannot contribute, so they stay what they are.
+        if lights.len() == 1
+            && matches!(
+                kind,
+                LightSamplerKind::Uniform | LightSamplerKind::Power | LightSamplerKind::Array
+            )
+        {
+            return LightSampler::Single;
         }
         // Where no power can be estimated (zero everywhere), every sampler falls back to
         // uniform picks so that nothing that might emit is ignored.
@@ -100,6 +111,7 @@ impl LightSampler {
         };
         match self {
             LightSampler::Empty => None,
+            LightSampler::Single => Some(pick(0, 1.0)),
             LightSampler::Uniform { count } => {
                 let i = ((u * *count as f32) as u32).min(count - 1);
                 Some(pick(i, 1.0 / *count as f32))
@@ -123,6 +135,7 @@ impl LightSampler {
     pub fn pmf(&self, ctx: &ShadingCtx, light: LightId) -> f32 {
         match self {
             LightSampler::Empty => 0.0,
+            LightSampler::Single => 1.0,
             LightSampler::Uniform { count } => 1.0 / *count as f32,
             LightSampler::Power(table) => table.pmf(light.0 as usize),
             LightSampler::Array(a) => a.pmf(light.0),
@@ -140,7 +153,7 @@ mod tests {
     use crate::light::ParallelogramLight;
 
     #[test]
-    fn one_light_is_picked_with_probability_one_by_every_power_sampler() {
+    fn one_light_is_picked_with_probability_one_by_the_uniform_and_power_samplers() {
         let lamp = ParallelogramLight::new(Vec3::ZERO, Vec3::X, Vec3::Z, -Vec3::Y, Vec3::ONE)
             .map(Light::Parallelogram)
             .unwrap();
@@ -152,11 +165,17 @@ mod tests {
         // What the alias table and the array would give: the whole probability.
         let table = AliasTable::new(&[lights[0].power()]).unwrap();
         let array = LightArray::new(&[lights[0].power()]).unwrap();
-        for kind in [LightSamplerKind::Power, LightSamplerKind::Array] {
+        let uniform = LightSampler::Uniform { count: 1 };
+        for kind in [
+            LightSamplerKind::Uniform,
+            LightSamplerKind::Power,
+            LightSamplerKind::Array,
+        ] {
             let s = LightSampler::new(kind, 1, &lights);
             for u in [0.0, 0.3, 0.999_999] {
                 let pick = s.sample(&ctx, u, &lights).unwrap();
                 assert_eq!(pick.id, LightId(0));
+                assert_eq!(Some(pick), uniform.sample(&ctx, u, &lights));
                 assert_eq!(pick.pmf, table.sample(u).1);
                 assert_eq!(pick.pmf, array.sample(u).1);
                 assert_eq!(pick.mis_pmf, 1.0);
