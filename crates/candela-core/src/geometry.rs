@@ -132,31 +132,53 @@ pub struct WatertightRay {
     pub(crate) o_k: Vec3,
 }
 
+/// `[kx, ky]` by `kz` (row) and by whether `d[kz] < 0` (column): the two other axes in
+/// cyclic order, swapped for a negative `d[kz]` to keep the winding. A static table, so
+/// that it is not rebuilt on the stack at every ray.
+static AXES: [[[usize; 2]; 2]; 3] = [[[1, 2], [2, 1]], [[2, 0], [0, 2]], [[0, 1], [1, 0]]];
+
 impl WatertightRay {
     #[inline]
     pub fn new(ray: &Ray) -> WatertightRay {
+        WatertightRay::with_sz(ray, |_, dz| 1.0 / dz)
+    }
+
+    /// [`WatertightRay::new`] with `1/d[kz]` taken from `inv_d = ray.d.recip()`, which
+    /// traversal has computed anyway: the same division of the same value, so the same
+    /// bits, without a second one.
+    #[inline(always)]
+    pub(crate) fn from_recip(ray: &Ray, inv_d: Vec3) -> WatertightRay {
+        let inv = inv_d.to_array();
+        // SAFETY: `kz` is below 3.
+        WatertightRay::with_sz(ray, |kz, _| unsafe { *inv.get_unchecked(kz) })
+    }
+
+    /// `sz(kz, d[kz])` gives `1/d[kz]`.
+    #[inline(always)]
+    fn with_sz(ray: &Ray, sz: impl FnOnce(usize, f32) -> f32) -> WatertightRay {
         let d = ray.d.to_array();
-        // `d.abs().max_position()` (the first of equals), and the other two axes in cyclic
-        // order, swapped where d[kz] < 0 to keep the winding: selects and table lookups,
-        // no branches. Random directions made the branches mispredict about once a ray
-        // (callgrind's branch model on the Cornell render: 0.8 of 3.9 mispredictions a
-        // closest-hit query, 0.5 of 1.5 a shadow ray).
+        // `d.abs().max_position()` (the first of equals), and the other two axes from
+        // `AXES`: selects and a table lookup, no branches. Random directions made the
+        // branches mispredict about once a ray (callgrind's branch model on the Cornell
+        // render: 0.8 of 3.9 mispredictions a closest-hit query, 0.5 of 1.5 a shadow
+        // ray).
         let a = ray.d.abs();
         let y_wins = a.y > a.x;
         let max = if y_wins { a.y } else { a.x };
         let kz = if a.z > max { 2 } else { y_wins as usize };
-        let flip = d[kz] < 0.0;
-        let next = [[1, 2], [2, 0], [0, 1]][kz];
-        let (kx, ky) = (next[flip as usize], next[!flip as usize]);
-        let sz = 1.0 / d[kz];
         let o = ray.o.to_array();
+        // SAFETY: called only with `kz` (0, 1 or 2) and entries of `AXES` (the same).
+        let at = |v: &[f32; 3], k: usize| unsafe { *v.get_unchecked(k) };
+        let dz = at(&d, kz);
+        let [kx, ky] = AXES[kz][(dz < 0.0) as usize];
+        let sz = sz(kz, dz);
         WatertightRay {
             o: ray.o,
             kx,
             ky,
             kz,
-            shear: Vec3::new(d[kx] * sz, d[ky] * sz, sz),
-            o_k: Vec3::new(o[kx], o[ky], o[kz]),
+            shear: Vec3::new(at(&d, kx) * sz, at(&d, ky) * sz, sz),
+            o_k: Vec3::new(at(&o, kx), at(&o, ky), at(&o, kz)),
         }
     }
 

@@ -224,16 +224,26 @@ impl Block {
         // register that has a `hit` bit.
         let lane_of = |row: *const [f32; LANES], lane: usize| unsafe { (*row)[lane] };
         let t = |lane| lane_of(std::ptr::addr_of!((*out).t), lane);
-        if ANY && hit != 0 {
-            // Some lane is hit; a shadow ray needs no more (nor the barycentrics).
+        // Some lane is hit and a shadow ray needs no more (nor the barycentrics); or one
+        // lane alone is hit and none needs the scalar test, so it is the nearest (its
+        // distance is below `t_max`): the commonest case of a closest-hit query, 1.03 hit
+        // lanes a hit block on the Cornell render, which the loop below would find with
+        // its bookkeeping (callgrind, Cornell 128² 1 spp: 573.9 -> 569.5 instructions a
+        // closest-hit query).
+        let alone = hit & hit.wrapping_sub(1) == 0 && edge | special == 0;
+        if hit != 0 && (ANY || alone) {
             let lane = hit.trailing_zeros() as usize;
+            let (b1, b2) = if ANY {
+                (0.0, 0.0)
+            } else {
+                (
+                    lane_of(std::ptr::addr_of!((*out).b1), lane),
+                    lane_of(std::ptr::addr_of!((*out).b2), lane),
+                )
+            };
             return Some(LaneHit {
                 id: self.id[lane] & ID_MASK,
-                hit: TriangleHit {
-                    t: t(lane),
-                    b1: 0.0,
-                    b2: 0.0,
-                },
+                hit: TriangleHit { t: t(lane), b1, b2 },
             });
         }
         let mut best = None;

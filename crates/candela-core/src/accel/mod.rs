@@ -25,7 +25,7 @@ use glam::Vec3;
 
 #[cfg(target_arch = "x86_64")]
 use crate::bvh::{Avx2Boxes, SseBoxes};
-use crate::bvh::{BoxTest, Bvh, Node8, QNode8, SahCost, ScalarBoxes, WideBvh, WideNode};
+use crate::bvh::{BoxTest, Bvh, Node8, QNode8, Ray8, SahCost, ScalarBoxes, WideBvh, WideNode};
 use crate::geometry::{Aabb, Ray, TriangleHit, WatertightRay};
 use block::{Block, FILTERED, ID_MASK, LANES, SPHERE};
 
@@ -282,10 +282,11 @@ impl Accel {
         t_max: f32,
         filter: &impl Fn(u32, &TriangleHit) -> bool,
     ) -> Option<Hit> {
-        let wray = WatertightRay::new(ray);
+        let r8 = Ray8::new(ray);
+        let wray = WatertightRay::from_recip(ray, r8.inv_d);
         let mut best: Option<Hit> = None;
         tree.intersect::<K>(
-            ray,
+            &r8,
             t_max,
             #[inline(always)]
             |block, count, t_max| {
@@ -337,9 +338,10 @@ impl Accel {
         t_max: f32,
         filter: &impl Fn(u32, &TriangleHit) -> bool,
     ) -> bool {
-        let wray = WatertightRay::new(ray);
+        let r8 = Ray8::new(ray);
+        let wray = WatertightRay::from_recip(ray, r8.inv_d);
         tree.occluded::<K>(
-            ray,
+            &r8,
             t_max,
             #[inline(always)]
             |block, count, t_max| {

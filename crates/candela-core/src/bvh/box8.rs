@@ -36,6 +36,9 @@ pub struct Ray8 {
     /// Index into [`Planes8`] of each axis's near plane (0/2/4 for a positive direction,
     /// 1/3/5 for a negative one); the far plane is the other one.
     pub near: [usize; 3],
+    /// Whether the ray's origin and direction are finite (traversal finds nothing for
+    /// one that is not).
+    pub finite: bool,
 }
 
 impl Ray8 {
@@ -47,8 +50,18 @@ impl Ray8 {
             inv_d,
             inv_far: inv_d * FAR_SCALE,
             near: [near(0, inv_d.x), near(1, inv_d.y), near(2, inv_d.z)],
+            finite: finite(ray),
         }
     }
+}
+
+/// Whether the ray's origin and direction are finite: `x · 0` is ±0 for a finite `x`
+/// and NaN otherwise, so one sum tests all six (a third of the instructions of six
+/// `is_finite`s and no branches; callgrind, Cornell render).
+#[inline(always)]
+fn finite(ray: &Ray) -> bool {
+    let z = ray.o * 0.0 + ray.d * 0.0;
+    z.x + z.y + z.z == 0.0
 }
 
 /// Which SIMD kernels the traversal and the triangle blocks use. All give the same bits;
