@@ -1,7 +1,8 @@
 #!/bin/sh
-# relMSE of the Sobol' sampler against the independent one at equal spp (issue 10).
+# relMSE of samplers at equal spp (issue 10; default: independent and sobol).
 # Usage: bench/sampler.sh [--downscale N] [--spp 4,16,64] [--seeds N] [--ref-spp N]
-#                         [--threads N] [SCENE...]   (default scenes: Cornell box, DOF)
+#                         [--threads N] [--samplers sobol,cmj,...] [--ref-cache DIR]
+#                         [SCENE...]   (default scenes: Cornell box, DOF)
 # Not run in CI; see crates/candela-scene/examples/sampler_relmse.rs for the metric.
 set -e
 cd "$(dirname "$0")/.."

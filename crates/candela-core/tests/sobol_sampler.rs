@@ -13,34 +13,11 @@
 //! this file with Šidák's correction. A pair of consecutive sample indices of one pixel is
 //! *not* uniform on the square (the pair is stratified), and the same test rejects it.
 
-use candela_core::chi2::{sidak_alpha, ChiSquareTest};
-use candela_core::sampler::{IndependentSampler, Sampler, SobolSampler};
+mod sampler_checks;
+
+use candela_core::sampler::{IndependentSampler, SobolSampler};
 use glam::{UVec2, Vec2};
-
-/// One request of a pixel sample: `skip` 2D requests first, then a 1D or 2D one.
-#[derive(Clone, Copy, Debug)]
-enum Request {
-    OneD { skip: u32 },
-    TwoD { skip: u32 },
-}
-
-fn draw<S: Sampler>(s: &mut S, pixel: UVec2, index: u32, req: Request) -> Vec2 {
-    s.start_pixel_sample(pixel, index);
-    match req {
-        Request::OneD { skip } => {
-            (0..skip).for_each(|_| {
-                s.get_2d();
-            });
-            Vec2::new(s.get_1d(), 0.0)
-        }
-        Request::TwoD { skip } => {
-            (0..skip).for_each(|_| {
-                s.get_2d();
-            });
-            s.get_2d()
-        }
-    }
-}
+use sampler_checks::{chi2_over_pixels, draw, points, two_requests_are_independent, Request};
 
 /// Whether the points are a (0, k, 2)-net (2D) or a one-per-stratum set (1D), k = log2 n.
 fn is_stratified(points: &[Vec2], two_d: bool) -> bool {
@@ -61,15 +38,6 @@ fn is_stratified(points: &[Vec2], two_d: bool) -> bool {
             !std::mem::replace(&mut seen[cell], true)
         })
     })
-}
-
-fn points<S: Sampler>(
-    s: &mut S,
-    pixel: UVec2,
-    indices: std::ops::Range<u32>,
-    req: Request,
-) -> Vec<Vec2> {
-    indices.map(|i| draw(s, pixel, i, req)).collect()
 }
 
 const REQUESTS: [Request; 6] = [
@@ -145,28 +113,6 @@ fn the_stratification_check_rejects_independent_samples() {
 /// Chi-square tests in this file, for the Šidák correction.
 const CHI2_TESTS: usize = 6;
 
-fn chi2_over_pixels(
-    name: &str,
-    mut point: impl FnMut(UVec2) -> Vec2,
-) -> candela_core::chi2::Chi2Report {
-    let test = ChiSquareTest {
-        alpha: sidak_alpha(0.01, CHI2_TESTS),
-        ..Default::default()
-    };
-    let mut k = 0u32;
-    test.planar(
-        name,
-        Vec2::ZERO,
-        Vec2::ONE,
-        |_| {
-            let pixel = UVec2::new(k % 1000, k / 1000);
-            k += 1;
-            Some(point(pixel))
-        },
-        |_| 1.0,
-    )
-}
-
 #[test]
 fn across_pixels_every_request_is_uniform() {
     let mut s = SobolSampler::new(4);
@@ -175,7 +121,7 @@ fn across_pixels_every_request_is_uniform() {
         (5, Request::TwoD { skip: 7 }),
         (77, Request::TwoD { skip: 40 }),
     ] {
-        let report = chi2_over_pixels(&format!("sample {index}, {req:?}"), |p| {
+        let report = chi2_over_pixels(CHI2_TESTS, &format!("sample {index}, {req:?}"), |p| {
             draw(&mut s, p, index, req)
         });
         eprintln!("sample {index}, {req:?}: p = {:.3}", report.p_value);
@@ -185,18 +131,7 @@ fn across_pixels_every_request_is_uniform() {
 
 #[test]
 fn across_pixels_two_requests_are_independent() {
-    // The first coordinate of two different requests of one pixel sample (and a 1D
-    // request against a 2D one): padding must leave no correlation between them.
-    let mut s = SobolSampler::new(5);
-    for (a, b) in [(0u32, 1u32), (2, 9)] {
-        let report = chi2_over_pixels(&format!("requests {a} and {b}"), |p| {
-            let x = draw(&mut s, p, 3, Request::TwoD { skip: a }).x;
-            let y = draw(&mut s, p, 3, Request::OneD { skip: b }).x;
-            Vec2::new(x, y)
-        });
-        eprintln!("requests {a}, {b}: p = {:.3}", report.p_value);
-        report.assert_passed();
-    }
+    two_requests_are_independent(SobolSampler::new(5), CHI2_TESTS);
 }
 
 #[test]
@@ -206,13 +141,13 @@ fn consecutive_samples_of_a_pixel_are_stratified_not_independent() {
     // sampler's pair is uniform.
     let req = Request::OneD { skip: 2 };
     let mut sobol = SobolSampler::new(6);
-    let report = chi2_over_pixels("Sobol', samples 6 and 7", |p| {
+    let report = chi2_over_pixels(CHI2_TESTS, "Sobol', samples 6 and 7", |p| {
         Vec2::new(draw(&mut sobol, p, 6, req).x, draw(&mut sobol, p, 7, req).x)
     });
     eprintln!("Sobol' pair: p = {:.3e}", report.p_value);
     assert!(!report.passed(), "the stratified pair looked independent");
     let mut independent = IndependentSampler::new(6);
-    let report = chi2_over_pixels("independent, samples 6 and 7", |p| {
+    let report = chi2_over_pixels(CHI2_TESTS, "independent, samples 6 and 7", |p| {
         Vec2::new(
             draw(&mut independent, p, 6, req).x,
             draw(&mut independent, p, 7, req).x,

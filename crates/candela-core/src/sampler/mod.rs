@@ -7,14 +7,19 @@
 //! dimensions in a fixed order: light pick (1D), light point (2D), BSDF lobe (1D), BSDF
 //! direction (2D), Russian roulette (1D). A low-discrepancy sampler can rely on that order.
 //!
-//! Two samplers: [`IndependentSampler`] (uniform random numbers) and [`SobolSampler`]
-//! (Owen-scrambled Sobol' points, stratified within each pixel). The integrator picks one
-//! by [`crate::desc::SamplerKind`] and is monomorphized for each, so no call is dynamic.
+//! Three samplers: [`IndependentSampler`] (uniform random numbers), [`SobolSampler`]
+//! (Owen-scrambled Sobol' points, stratified within each pixel) and [`CmjSampler`]
+//! (correlated multi-jittered points, stratified within each pixel, for the study in
+//! `bench/sampler.sh`; the renderer does not offer it).
+//! The integrator picks one by [`crate::desc::SamplerKind`] and is monomorphized for each,
+//! so no call is dynamic.
 
+mod cmj;
 mod sobol;
 
 use glam::{UVec2, Vec2};
 
+pub use cmj::CmjSampler;
 pub use sobol::{owen_scramble, sobol_2d, SobolSampler};
 
 /// A source of uniform numbers in [0, 1) for one pixel sample at a time.
