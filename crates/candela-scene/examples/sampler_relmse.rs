@@ -384,14 +384,11 @@ fn main() {
         args.ref_spp,
         args.threads,
         join(&args.samplers),
-        join(
-            &args
-                .scenes
-                .iter()
-                .map(|p| p.display().to_string())
-                .collect::<Vec<_>>()
-        )
-        .replace(',', " ")
+        args.scenes
+            .iter()
+            .map(|p| p.display().to_string())
+            .collect::<Vec<_>>()
+            .join(" ")
     );
     println!(
         "| scene | res | spp | sampler | relMSE (mean ± s.e.) | min – max over seeds | \
