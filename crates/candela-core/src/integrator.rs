@@ -248,7 +248,7 @@ pub fn li<S: Sampler>(scene: &Scene, mut ray: Ray, sampler: &mut S, rays: &mut u
         {
             break;
         }
-        let Some(si) = hit else {
+        let Some(si) = hit.as_ref() else {
             for &id in &scene.infinite_lights {
                 let light = scene.light(id);
                 let le = if depth == 0 {
@@ -273,7 +273,7 @@ pub fn li<S: Sampler>(scene: &Scene, mut ray: Ray, sampler: &mut S, rays: &mut u
             break;
         };
 
-        let bsdf = scene.materials[si.material.0 as usize].bsdf_at(&si);
+        let bsdf = scene.materials[si.material.0 as usize].bsdf_at(si);
         let ctx = ShadingCtx { p: si.p, n: si.ns };
         // The next direction first: it does not depend on light sampling, so its chain of
         // divisions and square roots runs while the shadow ray is traced.
@@ -284,7 +284,7 @@ pub fn li<S: Sampler>(scene: &Scene, mut ray: Ray, sampler: &mut S, rays: &mut u
         };
         let bs = bsdf.sample(wo, u_lobe, u.dir);
         if !bsdf.is_delta() {
-            l += beta * sample_direct(scene, &si, &ctx, &bsdf, wo, u.light, u.point, rays);
+            l += beta * sample_direct(scene, si, &ctx, &bsdf, wo, u.light, u.point, rays);
         }
         let Some(bs) = bs else {
             break;
