@@ -309,14 +309,21 @@ fn li_isa<S: Sampler, const V3: bool>(
         };
         let bs = bsdf.sample(wo, u_lobe, u.dir);
         if !bsdf.is_delta() {
-            let (lu, pu) = (u.light, u.point);
+            let v = NeeVertex {
+                si,
+                ctx: &ctx,
+                bsdf: &bsdf,
+                wo,
+                u_light: u.light,
+                u_point: u.point,
+            };
             l += beta
                 * match V3 {
                     // SAFETY: only the v3 copy of the render loop has `V3`, and `render_with`
                     // asserted that the CPU runs it.
                     #[cfg(target_arch = "x86_64")]
-                    true => unsafe { sample_direct_v3(scene, si, &ctx, &bsdf, wo, lu, pu, rays) },
-                    _ => sample_direct_baseline(scene, si, &ctx, &bsdf, wo, lu, pu, rays),
+                    true => unsafe { sample_direct_v3(scene, &v, rays) },
+                    _ => sample_direct_baseline(scene, &v, rays),
                 };
         }
         let Some(bs) = bs else {
@@ -398,19 +405,9 @@ macro_rules! sample_direct_copy {
     ($copy:ident, $doc:literal, $name:ident) => {
         $copy! {
         #[doc = $doc]
-        #[allow(clippy::too_many_arguments)]
         #[inline(never)]
-        fn $name(
-            scene: &Scene,
-            si: &SurfaceInteraction,
-            ctx: &ShadingCtx,
-            bsdf: &Bsdf,
-            wo: Vec3,
-            u_light: f32,
-            u_point: Vec2,
-            rays: &mut u64,
-        ) -> Vec3 {
-            sample_direct(scene, si, ctx, bsdf, wo, u_light, u_point, rays)
+        fn $name(scene: &Scene, v: &NeeVertex, rays: &mut u64) -> Vec3 {
+            sample_direct(scene, v, rays)
         }
         }
     };
@@ -427,20 +424,31 @@ sample_direct_copy!(
     sample_direct_v3
 );
 
+/// What next event estimation at a path vertex takes.
+#[derive(Clone, Copy)]
+struct NeeVertex<'a> {
+    si: &'a SurfaceInteraction,
+    ctx: &'a ShadingCtx,
+    bsdf: &'a Bsdf,
+    wo: Vec3,
+    /// The light pick's number (see [`BounceSamples::light`]).
+    u_light: f32,
+    /// The point on the light.
+    u_point: Vec2,
+}
+
 /// Next event estimation: one light picked by the light sampler, one point on it, a
 /// shadow ray, and the MIS weight against BSDF sampling of the same direction.
-#[allow(clippy::too_many_arguments)]
 #[inline(always)]
-fn sample_direct(
-    scene: &Scene,
-    si: &SurfaceInteraction,
-    ctx: &ShadingCtx,
-    bsdf: &Bsdf,
-    wo: Vec3,
-    u_light: f32,
-    u_point: Vec2,
-    rays: &mut u64,
-) -> Vec3 {
+fn sample_direct(scene: &Scene, v: &NeeVertex, rays: &mut u64) -> Vec3 {
+    let NeeVertex {
+        si,
+        ctx,
+        bsdf,
+        wo,
+        u_light,
+        u_point,
+    } = *v;
     let mode = scene.settings.mis;
     let Some(pick) = scene.light_sampler.sample(ctx, u_light, &scene.lights) else {
         return Vec3::ZERO;
