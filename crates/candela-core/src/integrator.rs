@@ -118,7 +118,7 @@ pub fn render_with<S: Sampler>(
                     // SAFETY: the assertion above checked that the CPU has x86-64-v3.
                     #[cfg(target_arch = "x86_64")]
                     crate::desc::Isa::V3 => unsafe { render_pixels_v3(scene, &mut sampler, band) },
-                    _ => render_pixels(scene, &mut sampler, band),
+                    _ => render_pixels::<S, false>(scene, &mut sampler, band),
                 };
                 progress(done);
                 s
@@ -135,14 +135,23 @@ pub fn render_with<S: Sampler>(
     }
 }
 
-/// [`render_pixels`] compiled for x86-64-v3 (see [`crate::isa`]; the list is the one
+/// Marks a function compiled for x86-64-v3 (see [`crate::isa`]; the list is the one
 /// `Isa::is_supported` detects).
-#[cfg(target_arch = "x86_64")]
-#[target_feature(
-    enable = "avx,avx2,bmi1,bmi2,cmpxchg16b,f16c,fma,lzcnt,movbe,popcnt,sse3,sse4.1,sse4.2,ssse3,xsave"
-)]
-fn render_pixels_v3<S: Sampler>(scene: &Scene, sampler: &mut S, band: Band) -> RenderStats {
-    render_pixels(scene, sampler, band)
+macro_rules! v3_fn {
+    ($f:item) => {
+        #[cfg(target_arch = "x86_64")]
+        #[target_feature(
+            enable = "avx,avx2,bmi1,bmi2,cmpxchg16b,f16c,fma,lzcnt,movbe,popcnt,sse3,sse4.1,sse4.2,ssse3,xsave"
+        )]
+        $f
+    };
+}
+
+v3_fn! {
+    /// [`render_pixels`] compiled for x86-64-v3.
+    fn render_pixels_v3<S: Sampler>(scene: &Scene, sampler: &mut S, band: Band) -> RenderStats {
+        render_pixels::<S, true>(scene, sampler, band)
+    }
 }
 
 /// One work item: rows from `y0` of an image `width` pixels wide, and the sample indices
@@ -155,9 +164,14 @@ struct Band<'a> {
 }
 
 /// Takes a band's samples; inlined into each copy of the render loop, so that it and
-/// its callees are compiled for each.
+/// its callees are compiled for each. `V3`: whether this is the x86-64-v3 copy (which
+/// then calls the v3 copy of next event estimation).
 #[inline(always)]
-fn render_pixels<S: Sampler>(scene: &Scene, sampler: &mut S, band: Band) -> RenderStats {
+fn render_pixels<S: Sampler, const V3: bool>(
+    scene: &Scene,
+    sampler: &mut S,
+    band: Band,
+) -> RenderStats {
     let Band {
         pixels,
         width,
@@ -181,7 +195,7 @@ fn render_pixels<S: Sampler>(scene: &Scene, sampler: &mut S, band: Band) -> Rend
                 Vec2::splat(0.5)
             };
             let ray = scene.camera.generate_lens_ray(film_pos, lens_u);
-            let l = li(scene, ray, sampler, &mut stats.rays);
+            let l = li_isa::<S, V3>(scene, ray, sampler, &mut stats.rays);
             stats.paths += 1;
             pixel.add(l, 1.0);
         }
@@ -199,7 +213,18 @@ fn mis_weight(mode: MisMode, pdf_f: f32, pdf_g: f32) -> f32 {
 
 /// Radiance arriving along `ray`, estimated by one path.
 #[inline(always)]
-pub fn li<S: Sampler>(scene: &Scene, mut ray: Ray, sampler: &mut S, rays: &mut u64) -> Vec3 {
+pub fn li<S: Sampler>(scene: &Scene, ray: Ray, sampler: &mut S, rays: &mut u64) -> Vec3 {
+    li_isa::<S, false>(scene, ray, sampler, rays)
+}
+
+/// [`li`] in the copy of the render loop `V3` says (see [`render_pixels`]).
+#[inline(always)]
+fn li_isa<S: Sampler, const V3: bool>(
+    scene: &Scene,
+    mut ray: Ray,
+    sampler: &mut S,
+    rays: &mut u64,
+) -> Vec3 {
     let mode = scene.settings.mis;
     let mut l = Vec3::ZERO;
     let mut beta = Vec3::ONE;
@@ -248,7 +273,7 @@ pub fn li<S: Sampler>(scene: &Scene, mut ray: Ray, sampler: &mut S, rays: &mut u
         {
             break;
         }
-        let Some(si) = hit else {
+        let Some(si) = hit.as_ref() else {
             for &id in &scene.infinite_lights {
                 let light = scene.light(id);
                 let le = if depth == 0 {
@@ -273,7 +298,7 @@ pub fn li<S: Sampler>(scene: &Scene, mut ray: Ray, sampler: &mut S, rays: &mut u
             break;
         };
 
-        let bsdf = scene.materials[si.material.0 as usize].bsdf_at(&si);
+        let bsdf = scene.materials[si.material.0 as usize].bsdf_at(si);
         let ctx = ShadingCtx { p: si.p, n: si.ns };
         // The next direction first: it does not depend on light sampling, so its chain of
         // divisions and square roots runs while the shadow ray is traced.
@@ -284,7 +309,22 @@ pub fn li<S: Sampler>(scene: &Scene, mut ray: Ray, sampler: &mut S, rays: &mut u
         };
         let bs = bsdf.sample(wo, u_lobe, u.dir);
         if !bsdf.is_delta() {
-            l += beta * sample_direct(scene, &si, &ctx, &bsdf, wo, u.light, u.point, rays);
+            let v = NeeVertex {
+                si,
+                ctx: &ctx,
+                bsdf: &bsdf,
+                wo,
+                u_light: u.light,
+                u_point: u.point,
+            };
+            l += beta
+                * match V3 {
+                    // SAFETY: only the v3 copy of the render loop has `V3`, and `render_with`
+                    // asserted that the CPU runs it.
+                    #[cfg(target_arch = "x86_64")]
+                    true => unsafe { sample_direct_v3(scene, &v, rays) },
+                    _ => sample_direct_baseline(scene, &v, rays),
+                };
         }
         let Some(bs) = bs else {
             break;
@@ -352,19 +392,63 @@ impl<S: Sampler> BounceSamples<S> {
     }
 }
 
+/// An item as it is: the baseline counterpart of [`v3_fn`].
+macro_rules! baseline_fn {
+    ($f:item) => {
+        $f
+    };
+}
+
+/// Defines `$name`, [`sample_direct`] compiled out of line (inlined into the loop it
+/// measured slower), through `$copy` (`baseline_fn` or `v3_fn`).
+macro_rules! sample_direct_copy {
+    ($copy:ident, $doc:literal, $name:ident) => {
+        $copy! {
+        #[doc = $doc]
+        #[inline(never)]
+        fn $name(scene: &Scene, v: &NeeVertex, rays: &mut u64) -> Vec3 {
+            sample_direct(scene, v, rays)
+        }
+        }
+    };
+}
+
+sample_direct_copy!(
+    baseline_fn,
+    "[`sample_direct`] for the baseline target.",
+    sample_direct_baseline
+);
+sample_direct_copy!(
+    v3_fn,
+    "[`sample_direct`] compiled for x86-64-v3, called by the v3 copy of the loop.",
+    sample_direct_v3
+);
+
+/// What next event estimation at a path vertex takes.
+#[derive(Clone, Copy)]
+struct NeeVertex<'a> {
+    si: &'a SurfaceInteraction,
+    ctx: &'a ShadingCtx,
+    bsdf: &'a Bsdf,
+    wo: Vec3,
+    /// The light pick's number (see [`BounceSamples::light`]).
+    u_light: f32,
+    /// The point on the light.
+    u_point: Vec2,
+}
+
 /// Next event estimation: one light picked by the light sampler, one point on it, a
 /// shadow ray, and the MIS weight against BSDF sampling of the same direction.
-#[allow(clippy::too_many_arguments)]
-fn sample_direct(
-    scene: &Scene,
-    si: &SurfaceInteraction,
-    ctx: &ShadingCtx,
-    bsdf: &Bsdf,
-    wo: Vec3,
-    u_light: f32,
-    u_point: Vec2,
-    rays: &mut u64,
-) -> Vec3 {
+#[inline(always)]
+fn sample_direct(scene: &Scene, v: &NeeVertex, rays: &mut u64) -> Vec3 {
+    let NeeVertex {
+        si,
+        ctx,
+        bsdf,
+        wo,
+        u_light,
+        u_point,
+    } = *v;
     let mode = scene.settings.mis;
     let Some(pick) = scene.light_sampler.sample(ctx, u_light, &scene.lights) else {
         return Vec3::ZERO;

@@ -83,6 +83,7 @@ impl Camera {
     }
 
     /// Direction (camera frame, z = −1) of the pinhole ray through film position `film`.
+    #[inline]
     fn pinhole_direction(&self, film: Vec2) -> Vec3 {
         let ndc = film / self.resolution;
         let aspect = self.resolution.x / self.resolution.y;
@@ -91,23 +92,33 @@ impl Camera {
         Vec3::new(x, y, -1.0)
     }
 
+    #[inline]
     fn to_world(&self, v: Vec3) -> Vec3 {
         self.right * v.x + self.up * v.y + self.back * v.z
     }
 
     /// The ray through film position `film` (in pixels, (0,0) at the top left) from the
     /// centre of the lens: the pinhole ray.
+    #[inline]
     pub fn generate_ray(&self, film: Vec2) -> Ray {
         let d = self.to_world(self.pinhole_direction(film)).normalize();
         Ray::new(self.position, d)
     }
 
     /// The ray through film position `film` from the lens point of the uniform sample
-    /// `lens_u`; a pinhole ignores `lens_u`.
+    /// `lens_u`; a pinhole ignores `lens_u`. Inlined for a pinhole (into each copy of the
+    /// render loop, see [`crate::isa`]), a thin lens out of line.
+    #[inline]
     pub fn generate_lens_ray(&self, film: Vec2, lens_u: Vec2) -> Ray {
-        let Some(lens) = &self.lens else {
-            return self.generate_ray(film);
-        };
+        match &self.lens {
+            None => self.generate_ray(film),
+            Some(lens) => self.thin_lens_ray(lens, film, lens_u),
+        }
+    }
+
+    /// [`Self::generate_lens_ray`] through a thin lens.
+    #[inline(never)]
+    fn thin_lens_ray(&self, lens: &ThinLens, film: Vec2, lens_u: Vec2) -> Ray {
         let (o, d) = lens.ray(self.pinhole_direction(film), lens_u);
         Ray::new(
             self.position + self.to_world(o),

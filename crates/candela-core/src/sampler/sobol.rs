@@ -105,8 +105,20 @@ pub fn owen_scramble(v: u32, seed: u32) -> u32 {
 /// [`owen_scramble`] on bit-reversed input and output (the sampler keeps values reversed
 /// where it can, to save reversals).
 #[inline]
-fn scramble_reversed(mut v: u32, seed: u32) -> u32 {
-    v ^= v.wrapping_mul(0x3d20_adea);
+fn scramble_reversed(v: u32, seed: u32) -> u32 {
+    scramble_premixed(premix(v), seed)
+}
+
+/// The first step of [`scramble_reversed`], the one that does not depend on the seed: the
+/// sampler takes it once per pixel sample for the index that every request shuffles.
+#[inline(always)]
+fn premix(v: u32) -> u32 {
+    v ^ v.wrapping_mul(0x3d20_adea)
+}
+
+/// The rest of [`scramble_reversed`], from the output of [`premix`].
+#[inline(always)]
+fn scramble_premixed(mut v: u32, seed: u32) -> u32 {
     v = v.wrapping_add(seed);
     v = v.wrapping_mul((seed >> 16) | 1);
     v ^= v.wrapping_mul(0x0552_6c56);
@@ -127,8 +139,9 @@ pub struct SobolSampler {
     seed: u64,
     /// Hash of (seed, pixel) for the current pixel sample.
     pixel_key: u64,
-    /// The sample index, bit-reversed.
-    index_reversed: u32,
+    /// [`premix`] of the sample index bit-reversed: the seed-independent first step of
+    /// every request's shuffle, taken once per pixel sample.
+    index_premixed: u32,
     /// Requests taken so far in this pixel sample (a 2D request counts two).
     dimension: u32,
 }
@@ -138,7 +151,7 @@ impl SobolSampler {
         SobolSampler {
             seed,
             pixel_key: 0,
-            index_reversed: 0,
+            index_premixed: 0,
             dimension: 0,
         }
     }
@@ -160,7 +173,7 @@ impl SobolSampler {
             self.pixel_key
                 .wrapping_add((dimension as u64).wrapping_mul(GOLDEN)),
         );
-        let shuffled = scramble_reversed(self.index_reversed, h as u32).reverse_bits();
+        let shuffled = scramble_premixed(self.index_premixed, h as u32).reverse_bits();
         (shuffled, h)
     }
 
@@ -184,7 +197,7 @@ impl Sampler for SobolSampler {
     fn start_pixel_sample(&mut self, pixel: UVec2, index: u32) {
         let key = ((pixel.x as u64) << 32) | pixel.y as u64;
         self.pixel_key = mix64(self.seed ^ mix64(key));
-        self.index_reversed = index.reverse_bits();
+        self.index_premixed = premix(index.reverse_bits());
         self.dimension = 0;
     }
 
@@ -218,9 +231,7 @@ impl Sampler for SobolSampler {
         let (i, h) = self.next_request(2);
         let x = scramble_reversed(i, (h >> 32) as u32);
         let y = scramble_reversed(sobol_dim1_reversed(i), y_seed(h));
-        // Both coordinates reversed by one 64-bit reversal: (x, y) → (rev y, rev x).
-        let xy = ((x as u64) << 32 | y as u64).reverse_bits();
-        Vec2::new(to_unit(xy as u32), to_unit((xy >> 32) as u32))
+        Vec2::new(to_unit(x.reverse_bits()), to_unit(y.reverse_bits()))
     }
 }
 
