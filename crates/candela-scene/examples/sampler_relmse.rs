@@ -11,7 +11,9 @@
 //! half a half's error).
 //!
 //! Samplers (`--samplers`, comma-separated; the first is what the ratios divide by):
-//! `independent` and `sobol` (the renderer's), `cmj` (padded correlated multi-jittered points for every request), `owen` (`sobol`'s
+//! `independent`, `sobol` and `sobol-cmj` (the renderer's; `sobol-cmj` is `sobol` with the
+//! first bounce's BSDF direction from a CMJ pattern, the default), `cmj` (padded correlated
+//! multi-jittered points for every request), `owen` (`sobol`'s
 //! construction with true nested uniform scrambles: every bit flipped by an independent
 //! hash of the request, the level and the bits above it; slow, for the study only), and
 //! `BASE+OTHER@D1/D2/…`: BASE for every request except those starting at dimensions
