@@ -318,3 +318,91 @@ fn renders_do_not_depend_on_threads_and_split_ranges_add_up() {
         assert_ne!(whole.resolve(), plain.resolve(), "lens {lens}");
     }
 }
+
+/// One request as the integrator makes it: its kind and its first dimension.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Event {
+    Pixel(u32),
+    OneD(u32),
+    Skip(u32),
+    TwoD(u32),
+    Defer(u32),
+}
+
+/// Independent numbers, with every pixel sample's requests logged (shared by the clones
+/// the render makes per work item).
+#[derive(Clone)]
+struct Recorder {
+    inner: IndependentSampler,
+    dimension: u32,
+    log: Arc<std::sync::Mutex<Vec<Vec<Event>>>>,
+}
+
+impl Recorder {
+    fn push(&mut self, event: fn(u32) -> Event, width: u32) {
+        let mut log = self.log.lock().unwrap();
+        log.last_mut().unwrap().push(event(self.dimension));
+        self.dimension += width;
+    }
+}
+
+impl Sampler for Recorder {
+    fn start_pixel_sample(&mut self, pixel: UVec2, index: u32) {
+        self.inner.start_pixel_sample(pixel, index);
+        self.dimension = 0;
+        self.log.lock().unwrap().push(Vec::new());
+    }
+    fn get_1d(&mut self) -> f32 {
+        self.push(Event::OneD, 1);
+        self.inner.get_1d()
+    }
+    fn get_2d(&mut self) -> Vec2 {
+        self.push(Event::TwoD, 2);
+        self.inner.get_2d()
+    }
+    fn skip_1d(&mut self) {
+        self.push(Event::Skip, 1);
+        self.inner.skip_1d();
+    }
+    fn get_pixel_2d(&mut self) -> Vec2 {
+        self.push(Event::Pixel, 2);
+        self.inner.get_2d()
+    }
+    type Deferred1d = f32;
+    fn defer_1d(&mut self) -> f32 {
+        self.push(Event::Defer, 1);
+        self.inner.get_1d()
+    }
+    fn resolve_1d(&self, u: f32) -> f32 {
+        u
+    }
+}
+
+#[test]
+fn the_integrator_takes_the_first_direction_at_that_dimension() {
+    // The hybrid relies on the integrator's order of requests: pixel, lens, then the first
+    // bounce's light pick (skipped: one light), light point, lobe, direction.
+    for lens in [false, true] {
+        let scene = build(&lamp_over_floor(lens)).unwrap();
+        let log = Arc::new(std::sync::Mutex::new(Vec::new()));
+        let recorder = Recorder {
+            inner: IndependentSampler::new(1),
+            dimension: 0,
+            log: log.clone(),
+        };
+        let cancel = AtomicBool::new(false);
+        candela_core::integrator::render_with(&scene, recorder, 0..2, &cancel, &|_| {});
+        let d = first_direction_dimension(lens);
+        let mut want = vec![Event::Pixel(0)];
+        if lens {
+            want.push(Event::TwoD(2));
+        }
+        want.extend([Event::Skip(d - 4), Event::TwoD(d - 3), Event::Defer(d - 1)]);
+        want.push(Event::TwoD(d));
+        let log = log.lock().unwrap();
+        assert_eq!(log.len(), 24 * 16 * 2);
+        for events in log.iter() {
+            assert_eq!(events[..want.len()], want[..], "lens {lens}");
+        }
+    }
+}
