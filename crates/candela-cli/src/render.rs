@@ -114,8 +114,9 @@ pub struct RenderArgs {
     /// Candidates per pick of the `ris` and `ris-bvh` light samplers.
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..))]
     ris_candidates: Option<u32>,
-    /// Sample generator: independent (uniform random numbers) or sobol (Owen-scrambled
-    /// Sobol' points, stratified within each pixel).
+    /// Sample generator: independent (uniform random numbers), sobol (Owen-scrambled
+    /// Sobol' points, stratified within each pixel) or sobol-cmj (the default: sobol, but
+    /// the first bounce's BSDF direction from a correlated multi-jittered pattern).
     #[arg(long, value_parser = parse_name::<SamplerKind>)]
     sampler: Option<SamplerKind>,
     /// Which compiled copy of the render loop runs: auto (the fastest the CPU has),

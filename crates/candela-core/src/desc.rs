@@ -554,17 +554,24 @@ pub enum LightSamplerKind {
 }
 
 /// Where the integrator's uniform numbers come from (see [`crate::sampler`]). Its names in
-/// scene files and on the command line are `independent` and `sobol`.
+/// scene files and on the command line are `independent`, `sobol` and `sobol-cmj`.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum SamplerKind {
     /// Independent uniform numbers (PCG32).
     Independent,
-    /// Owen-scrambled Sobol' points, stratified within each pixel; the default, since
-    /// `bench/sampler.sh` measured 1.56× lower relMSE at 64 spp on the 512² Cornell box
-    /// and 1.68× on the depth-of-field scene for 5–10 % more time (bench/RESULTS.md).
-    #[default]
+    /// Owen-scrambled Sobol' points, stratified within each pixel: `bench/sampler.sh`
+    /// measured 1.56× lower relMSE than independent samples at 64 spp on the 512² Cornell
+    /// box and 1.68× on the depth-of-field scene for 5–10 % more time (bench/RESULTS.md).
     Sobol,
+    /// [`SamplerKind::Sobol`] except for the first bounce's BSDF direction, which comes
+    /// from a correlated multi-jittered pattern of the planned spp
+    /// ([`crate::sampler::SobolCmjSampler`]); the default, since it measured 1.135× lower
+    /// relMSE than `Sobol` on the Cornell box at 64 spp (1.025× at 16), level or better
+    /// on five other scenes, for ≈ 2.5 % more instructions in the render loop
+    /// (bench/RESULTS.md, stop 20).
+    #[default]
+    SobolCmj,
 }
 
 /// Which compiled copy of the render loop runs (see [`crate::isa`]). Its names on the

@@ -16,7 +16,7 @@ use crate::geometry::Ray;
 use crate::light::{Light, LightId, LightSample, ShadingCtx};
 use crate::light_sampler::LightPick;
 use crate::math::max_component;
-use crate::sampler::{IndependentSampler, Sampler, SobolSampler};
+use crate::sampler::{IndependentSampler, Sampler, SobolCmjSampler, SobolSampler};
 use crate::sampling::{balance_heuristic, power_heuristic};
 use crate::scene::{Scene, SurfaceInteraction};
 
@@ -72,6 +72,11 @@ pub fn render(
         ),
         SamplerKind::Sobol => {
             render_with(scene, SobolSampler::new(seed), samples, cancel, progress)
+        }
+        SamplerKind::SobolCmj => {
+            let s =
+                SobolCmjSampler::new(seed, scene.settings.spp, scene.camera.needs_lens_sample());
+            render_with(scene, s, samples, cancel, progress)
         }
     }
 }

@@ -14,9 +14,9 @@
 //! no variance at all (the furnace with BSDF sampling), a floor of 10⁻⁴·L covers f32
 //! round-off.
 //!
-//! Every scene is rendered with both samplers: the Sobol' sampler's pixels are as
+//! Every scene is rendered with each sampler: the Sobol' samplers' pixels are as
 //! independent of each other as the independent sampler's (each pixel has its own
-//! scrambles), so the same bounds apply to it.
+//! scrambles and patterns), so the same bounds apply to them.
 
 use std::sync::atomic::AtomicBool;
 
@@ -32,7 +32,11 @@ const MIS_MODES: [MisMode; 4] = [
     MisMode::BsdfOnly,
 ];
 
-const SAMPLERS: [SamplerKind; 2] = [SamplerKind::Independent, SamplerKind::Sobol];
+const SAMPLERS: [SamplerKind; 3] = [
+    SamplerKind::Independent,
+    SamplerKind::Sobol,
+    SamplerKind::SobolCmj,
+];
 
 fn material(name: &str, albedo: f32) -> MaterialDesc {
     MaterialDesc {

@@ -18,7 +18,9 @@ mod sampler_checks;
 
 use candela_core::sampler::{CmjSampler, IndependentSampler, Sampler};
 use glam::{UVec2, Vec2};
-use sampler_checks::{chi2_over_pixels, draw, points, two_requests_are_independent, Request};
+use sampler_checks::{
+    chi2_over_pixels, draw, one_per_cell, points, strata, two_requests_are_independent, Request,
+};
 
 const REQUESTS: [Request; 6] = [
     Request::TwoD { skip: 0 },
@@ -28,34 +30,6 @@ const REQUESTS: [Request; 6] = [
     Request::TwoD { skip: 7 },
     Request::TwoD { skip: 40 },
 ];
-
-/// Whether each of the `grids` (columns × rows) has exactly one point in every cell.
-fn one_per_cell(points: &[Vec2], grids: &[(u32, u32)]) -> bool {
-    grids.iter().all(|&(cols, rows)| {
-        assert_eq!((cols * rows) as usize, points.len());
-        let mut seen = vec![false; points.len()];
-        points.iter().all(|p| {
-            let ix = (p.x as f64 * cols as f64) as usize;
-            let iy = (p.y as f64 * rows as f64) as usize;
-            !std::mem::replace(&mut seen[iy * cols as usize + ix], true)
-        })
-    })
-}
-
-/// The cells a request of `n` samples must fill: its strata (1D), or its jittered grid
-/// and its n columns and n rows (2D).
-fn strata(n: u32, req: Request) -> Vec<(u32, u32)> {
-    match req {
-        Request::OneD { .. } => vec![(n, 1)],
-        Request::TwoD { .. } => {
-            let m = (1..=n)
-                .filter(|m| n.is_multiple_of(*m) && m * m <= n)
-                .max()
-                .unwrap();
-            vec![(m, n / m), (n, 1), (1, n)]
-        }
-    }
-}
 
 #[test]
 fn every_request_of_a_pixel_is_stratified() {

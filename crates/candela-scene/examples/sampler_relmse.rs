@@ -11,7 +11,9 @@
 //! half a half's error).
 //!
 //! Samplers (`--samplers`, comma-separated; the first is what the ratios divide by):
-//! `independent` and `sobol` (the renderer's), `cmj` (padded correlated multi-jittered points for every request), `owen` (`sobol`'s
+//! `independent`, `sobol` and `sobol-cmj` (the renderer's; `sobol-cmj` is `sobol` with the
+//! first bounce's BSDF direction from a CMJ pattern, the default), `cmj` (padded correlated
+//! multi-jittered points for every request), `owen` (`sobol`'s
 //! construction with true nested uniform scrambles: every bit flipped by an independent
 //! hash of the request, the level and the bits above it; slow, for the study only), and
 //! `BASE+OTHER@D1/D2/…`: BASE for every request except those starting at dimensions
@@ -30,7 +32,7 @@ use std::time::Instant;
 use candela_core::desc::SceneDesc;
 use candela_core::integrator::render_with;
 use candela_core::sampler::{
-    mix64, sobol_2d, CmjSampler, IndependentSampler, Sampler, SobolSampler,
+    mix64, sobol_2d, CmjSampler, IndependentSampler, Sampler, SobolCmjSampler, SobolSampler,
 };
 use glam::{UVec2, Vec2, Vec3};
 
@@ -86,7 +88,7 @@ fn parse_args() -> Result<Args, String> {
         );
     }
     for s in &a.samplers {
-        AnySampler::parse(s, 0, 1)?;
+        AnySampler::parse(s, 0, 1, false)?;
     }
     Ok(a)
 }
@@ -170,6 +172,7 @@ impl Sampler for OwenSobol {
 enum AnySampler {
     Independent(IndependentSampler),
     Sobol(SobolSampler),
+    SobolCmj(SobolCmjSampler),
     Cmj(CmjSampler),
     Owen(OwenSobol),
     /// `base` for every request except those starting at a dimension in `dims`.
@@ -189,7 +192,7 @@ enum Deferred {
 }
 
 impl AnySampler {
-    fn parse(name: &str, seed: u64, spp: u32) -> Result<AnySampler, String> {
+    fn parse(name: &str, seed: u64, spp: u32, lens: bool) -> Result<AnySampler, String> {
         if let Some((pair, dims)) = name.split_once('@') {
             let (base, other) = pair
                 .split_once('+')
@@ -199,8 +202,8 @@ impl AnySampler {
                 .map(|d| d.parse().map_err(|e| format!("{name}: {e}")))
                 .collect::<Result<_, _>>()?;
             return Ok(AnySampler::Hybrid {
-                base: Box::new(Self::parse(base, seed, spp)?),
-                other: Box::new(Self::parse(other, seed ^ 0xabcd_ef01, spp)?),
+                base: Box::new(Self::parse(base, seed, spp, lens)?),
+                other: Box::new(Self::parse(other, seed ^ 0xabcd_ef01, spp, lens)?),
                 dims,
                 dimension: 0,
             });
@@ -208,6 +211,7 @@ impl AnySampler {
         Ok(match name {
             "independent" => AnySampler::Independent(IndependentSampler::new(seed)),
             "sobol" => AnySampler::Sobol(SobolSampler::new(seed)),
+            "sobol-cmj" => AnySampler::SobolCmj(SobolCmjSampler::new(seed, spp, lens)),
             "cmj" => AnySampler::Cmj(CmjSampler::new(seed, spp)),
             "owen" => AnySampler::Owen(OwenSobol {
                 seed,
@@ -243,6 +247,7 @@ impl Sampler for AnySampler {
         match self {
             AnySampler::Independent(s) => s.start_pixel_sample(pixel, index),
             AnySampler::Sobol(s) => s.start_pixel_sample(pixel, index),
+            AnySampler::SobolCmj(s) => s.start_pixel_sample(pixel, index),
             AnySampler::Cmj(s) => s.start_pixel_sample(pixel, index),
             AnySampler::Owen(s) => s.start_pixel_sample(pixel, index),
             AnySampler::Hybrid {
@@ -266,6 +271,7 @@ impl Sampler for AnySampler {
         match self {
             AnySampler::Independent(s) => s.get_1d(),
             AnySampler::Sobol(s) => s.get_1d(),
+            AnySampler::SobolCmj(s) => s.get_1d(),
             AnySampler::Cmj(s) => s.get_1d(),
             AnySampler::Owen(s) => s.get_1d(),
             AnySampler::Hybrid { .. } => unreachable!(),
@@ -281,6 +287,7 @@ impl Sampler for AnySampler {
         match self {
             AnySampler::Independent(s) => s.get_2d(),
             AnySampler::Sobol(s) => s.get_2d(),
+            AnySampler::SobolCmj(s) => s.get_2d(),
             AnySampler::Cmj(s) => s.get_2d(),
             AnySampler::Owen(s) => s.get_2d(),
             AnySampler::Hybrid { .. } => unreachable!(),
@@ -301,6 +308,7 @@ impl Sampler for AnySampler {
         match self {
             AnySampler::Independent(s) => Deferred::Value(s.defer_1d()),
             AnySampler::Sobol(s) => Deferred::Dimension(s.defer_1d()),
+            AnySampler::SobolCmj(s) => Deferred::Dimension(s.defer_1d()),
             AnySampler::Cmj(s) => Deferred::Dimension(s.defer_1d()),
             AnySampler::Owen(s) => Deferred::Dimension(s.defer_1d()),
             AnySampler::Hybrid { .. } => unreachable!(),
@@ -310,6 +318,7 @@ impl Sampler for AnySampler {
         match (self, d) {
             (_, Deferred::Value(v)) => v,
             (AnySampler::Sobol(s), Deferred::Dimension(d)) => s.resolve_1d(d),
+            (AnySampler::SobolCmj(s), Deferred::Dimension(d)) => s.resolve_1d(d),
             (AnySampler::Cmj(s), Deferred::Dimension(d)) => s.resolve_1d(d),
             (AnySampler::Owen(s), Deferred::Dimension(d)) => s.resolve_1d(d),
             (AnySampler::Hybrid { base, other, .. }, Deferred::Pair(d, o)) => {
@@ -332,7 +341,8 @@ fn image(
     desc.render.seed = seed;
     desc.render.spp = range.len() as u32;
     let scene = candela_core::build::build(&desc).expect("scene builds");
-    let s = AnySampler::parse(sampler, seed, range.len() as u32).expect("checked");
+    let lens = scene.camera.needs_lens_sample();
+    let s = AnySampler::parse(sampler, seed, range.len() as u32, lens).expect("checked");
     let t = Instant::now();
     let r = render_with(&scene, s, range, &AtomicBool::new(false), &|_| {});
     (r.film.resolve(), t.elapsed().as_secs_f64())

@@ -78,6 +78,7 @@ fn render_settings_and_camera() {
     for (name, kind) in [
         ("independent", SamplerKind::Independent),
         ("sobol", SamplerKind::Sobol),
+        ("sobol-cmj", SamplerKind::SobolCmj),
     ] {
         let r = parse(&format!("[render]\nsampler = \"{name}\"")).render;
         assert_eq!(r.sampler, kind);
@@ -85,7 +86,7 @@ fn render_settings_and_camera() {
     let bad = parse_toml_scene("[render]\nsampler = \"halton\"\n", Path::new("scene.toml"));
     assert_eq!(
         bad.unwrap_err().to_string(),
-        "scene.toml:2:11: unknown variant `halton`, expected `independent` or `sobol`"
+        "scene.toml:2:11: unknown variant `halton`, expected one of `independent`, `sobol`, `sobol-cmj`"
     );
     // Defaults when the sections are absent.
     let d = parse("");

@@ -7,20 +7,25 @@
 //! dimensions in a fixed order: light pick (1D), light point (2D), BSDF lobe (1D), BSDF
 //! direction (2D), Russian roulette (1D). A low-discrepancy sampler can rely on that order.
 //!
-//! Three samplers: [`IndependentSampler`] (uniform random numbers), [`SobolSampler`]
-//! (Owen-scrambled Sobol' points, stratified within each pixel) and [`CmjSampler`]
-//! (correlated multi-jittered points, stratified within each pixel, for the study in
-//! `bench/sampler.sh`; the renderer does not offer it).
+//! Four samplers: [`IndependentSampler`] (uniform random numbers), [`SobolSampler`]
+//! (Owen-scrambled Sobol' points, stratified within each pixel), [`SobolCmjSampler`]
+//! (the Sobol' sampler's numbers except for the first bounce's BSDF direction, which a
+//! correlated multi-jittered pattern gives; that request sits at
+//! [`first_direction_dimension`] in the order above) and [`CmjSampler`] (correlated
+//! multi-jittered points for every request, for the study in `bench/sampler.sh`; the
+//! renderer does not offer it).
 //! The integrator picks one by [`crate::desc::SamplerKind`] and is monomorphized for each,
 //! so no call is dynamic.
 
 mod cmj;
 mod sobol;
+mod sobol_cmj;
 
 use glam::{UVec2, Vec2};
 
 pub use cmj::CmjSampler;
 pub use sobol::{owen_scramble, sobol_2d, SobolSampler};
+pub use sobol_cmj::{first_direction_dimension, SobolCmjSampler};
 
 /// A source of uniform numbers in [0, 1) for one pixel sample at a time.
 pub trait Sampler: Send + Sync + Clone {

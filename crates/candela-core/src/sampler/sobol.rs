@@ -177,6 +177,18 @@ impl SobolSampler {
         (shuffled, h)
     }
 
+    /// Requests taken so far in the current pixel sample (a 2D request counts two).
+    #[inline(always)]
+    pub(super) fn dimension(&self) -> u32 {
+        self.dimension
+    }
+
+    /// The current pixel's hash of (seed, pixel), from which every request's is derived.
+    #[inline(always)]
+    pub(super) fn pixel_key(&self) -> u64 {
+        self.pixel_key
+    }
+
     /// The 1D number of request `(i, h)`.
     #[inline(always)]
     fn number_1d((i, h): (u32, u64)) -> f32 {

@@ -80,3 +80,32 @@ pub fn two_requests_are_independent<S: Sampler>(mut s: S, tests: usize) {
         report.assert_passed();
     }
 }
+
+/// Whether each of the `grids` (columns × rows) has exactly one point in every cell (the
+/// check of a multi-jittered pattern's strata).
+pub fn one_per_cell(points: &[Vec2], grids: &[(u32, u32)]) -> bool {
+    grids.iter().all(|&(cols, rows)| {
+        assert_eq!((cols * rows) as usize, points.len());
+        let mut seen = vec![false; points.len()];
+        points.iter().all(|p| {
+            let ix = (p.x as f64 * cols as f64) as usize;
+            let iy = (p.y as f64 * rows as f64) as usize;
+            !std::mem::replace(&mut seen[iy * cols as usize + ix], true)
+        })
+    })
+}
+
+/// The cells a multi-jittered request of `n` samples must fill: its strata (1D), or its
+/// m × q grid (m the largest divisor of n not above √n) and its n columns and n rows (2D).
+pub fn strata(n: u32, req: Request) -> Vec<(u32, u32)> {
+    match req {
+        Request::OneD { .. } => vec![(n, 1)],
+        Request::TwoD { .. } => {
+            let m = (1..=n)
+                .filter(|m| n.is_multiple_of(*m) && m * m <= n)
+                .max()
+                .unwrap();
+            vec![(m, n / m), (n, 1), (1, n)]
+        }
+    }
+}
