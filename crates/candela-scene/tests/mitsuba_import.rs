@@ -356,7 +356,7 @@ fn render_settings_follow_film_sampler_and_integrator() {
         false,
     );
     let loaded = loaded.unwrap();
-    assert_eq!(loaded.desc.render.sampler, SamplerKind::Sobol);
+    assert_eq!(loaded.desc.render.sampler, SamplerKind::SobolCmj);
     assert!(
         loaded
             .warnings

@@ -207,11 +207,11 @@ fn sampler(ctx: &mut Ctx, node: &Node) -> Result<(), LoadError> {
     match node.kind() {
         "independent" => ctx.desc.render.sampler = SamplerKind::Independent,
         "stratified" | "multijitter" | "orthogonal" | "ldsampler" => {
-            ctx.desc.render.sampler = SamplerKind::Sobol;
+            ctx.desc.render.sampler = SamplerKind::default();
             ctx.warn(
                 node,
-                "Candela uses its Sobol' sampler instead; the image converges to the same \
-                 result",
+                "Candela uses its own stratified sampler (Sobol', the first bounce's \
+                 direction from a CMJ pattern) instead; the image converges to the same result",
             )
         }
         _ => return ctx.unsupported(node, format!("<{}> is not supported", describe(node))),
