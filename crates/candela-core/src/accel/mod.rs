@@ -291,7 +291,14 @@ impl Accel {
             #[inline(always)]
             |block, count, t_max| {
                 let block = &self.blocks[block as usize];
-                match block.intersect::<LEAF, false>(ray, &wray, count, t_max, filter) {
+                // Opaque to the optimizer, so that the block test's broadcasts of the
+                // watertight ray are made where a block is tested: otherwise they are
+                // hoisted into the query's setup and spilled, paid by every query though
+                // a shadow ray tests 0.64 blocks on average (callgrind, Cornell render
+                // 128², 1 spp: closest 559.3 -> 545.4 instructions a query, shadow
+                // 366.1 -> 347.1). A hint: it changes no result.
+                let wray = std::hint::black_box(&wray);
+                match block.intersect::<LEAF, false>(ray, wray, count, t_max, filter) {
                     Some(h) => {
                         best = Some(Hit {
                             prim: h.id,
@@ -345,8 +352,10 @@ impl Accel {
             t_max,
             #[inline(always)]
             |block, count, t_max| {
+                // As in `intersect_tree`: the broadcasts where a block is tested.
+                let wray = std::hint::black_box(&wray);
                 self.blocks[block as usize]
-                    .intersect::<LEAF, true>(ray, &wray, count, t_max, filter)
+                    .intersect::<LEAF, true>(ray, wray, count, t_max, filter)
                     .is_some()
             },
         )
