@@ -397,37 +397,21 @@ impl<S: Sampler> BounceSamples<S> {
     }
 }
 
-/// An item as it is: the baseline counterpart of [`v3_fn`].
-macro_rules! baseline_fn {
-    ($f:item) => {
-        $f
-    };
+/// [`sample_direct`] for the baseline target, out of line (inlined into the loop it
+/// measured slower).
+#[inline(never)]
+fn sample_direct_baseline(scene: &Scene, v: &NeeVertex, rays: &mut u64) -> Vec3 {
+    sample_direct(scene, v, rays)
 }
 
-/// Defines `$name`, [`sample_direct`] compiled out of line (inlined into the loop it
-/// measured slower), through `$copy` (`baseline_fn` or `v3_fn`).
-macro_rules! sample_direct_copy {
-    ($copy:ident, $doc:literal, $name:ident) => {
-        $copy! {
-        #[doc = $doc]
-        #[inline(never)]
-        fn $name(scene: &Scene, v: &NeeVertex, rays: &mut u64) -> Vec3 {
-            sample_direct(scene, v, rays)
-        }
-        }
-    };
+v3_fn! {
+    /// [`sample_direct`] compiled for x86-64-v3, out of line, called by the v3 copy of the
+    /// loop.
+    #[inline(never)]
+    fn sample_direct_v3(scene: &Scene, v: &NeeVertex, rays: &mut u64) -> Vec3 {
+        sample_direct(scene, v, rays)
+    }
 }
-
-sample_direct_copy!(
-    baseline_fn,
-    "[`sample_direct`] for the baseline target.",
-    sample_direct_baseline
-);
-sample_direct_copy!(
-    v3_fn,
-    "[`sample_direct`] compiled for x86-64-v3, called by the v3 copy of the loop.",
-    sample_direct_v3
-);
 
 /// What next event estimation at a path vertex takes.
 #[derive(Clone, Copy)]
