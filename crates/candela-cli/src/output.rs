@@ -59,18 +59,24 @@ pub fn write_image(
     write_atomically(path, &bytes)
 }
 
-/// Writes `bytes` to a temporary file beside `path`, then renames it into place.
+/// Writes `bytes` to a temporary file beside `path`, then renames it into place. The
+/// file gets the permissions of any newly created file (0666 less the umask, as
+/// `File::create` gives), not the temporary file's private 0600.
 pub fn write_atomically(path: &Path, bytes: &[u8]) -> Result<(), UserError> {
     let dir = match path.parent() {
         Some(p) if !p.as_os_str().is_empty() => p,
         _ => Path::new("."),
     };
     let fail = |e: std::io::Error| UserError(format!("{}: cannot write: {e}", path.display()));
-    let mut tmp = tempfile::Builder::new()
-        .prefix(".candela-")
-        .suffix(".tmp")
-        .tempfile_in(dir)
-        .map_err(fail)?;
+    let mut builder = tempfile::Builder::new();
+    builder.prefix(".candela-").suffix(".tmp");
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::PermissionsExt;
+        // Passed to open(2) with O_CREAT, so the kernel applies the umask.
+        builder.permissions(std::fs::Permissions::from_mode(0o666));
+    }
+    let mut tmp = builder.tempfile_in(dir).map_err(fail)?;
     tmp.write_all(bytes).map_err(fail)?;
     tmp.as_file().sync_all().map_err(fail)?;
     tmp.persist(path).map_err(|e| fail(e.error))?;
@@ -165,6 +171,22 @@ mod tests {
                 "the bytes changed between runs"
             );
         }
+    }
+
+    /// An image is readable as any file the user creates is, not private like the
+    /// temporary file it is written through.
+    #[cfg(unix)]
+    #[test]
+    fn written_file_has_a_new_files_permissions() {
+        use std::os::unix::fs::PermissionsExt;
+        let dir = tempfile::tempdir().unwrap();
+        let reference = dir.path().join("reference");
+        std::fs::File::create(&reference).unwrap();
+        let out = dir.path().join("out.pfm");
+        write_atomically(&out, b"bytes").unwrap();
+        let mode = |p: &Path| std::fs::metadata(p).unwrap().permissions().mode() & 0o777;
+        assert_eq!(mode(&out), mode(&reference));
+        assert_eq!(std::fs::read(&out).unwrap(), b"bytes");
     }
 
     #[test]
