@@ -20,6 +20,7 @@
 
 use glam::{UVec2, Vec2};
 
+use super::sobol::scramble_reversed;
 use super::{mix64, Sampler};
 
 /// The bits of numbers below `l`: the mask of [`permute`]'s cycle walk (0 for l ≤ 1).
@@ -87,13 +88,8 @@ fn fast_permute(v: u32, l: u32, w: u32, seed: u32) -> u32 {
 
 /// The Laine–Karras hash of `v` (the Sobol' sampler's scramble), its bits under `w`.
 #[inline(always)]
-fn lk_permute(mut v: u32, w: u32, seed: u32) -> u32 {
-    v ^= v.wrapping_mul(0x3d20_adea);
-    v = v.wrapping_add(seed);
-    v = v.wrapping_mul((seed >> 16) | 1);
-    v ^= v.wrapping_mul(0x0552_6c56);
-    v ^= v.wrapping_mul(0x53a2_2864);
-    v & w
+fn lk_permute(v: u32, w: u32, seed: u32) -> u32 {
+    scramble_reversed(v, seed) & w
 }
 
 /// Kensler's `randfloat` without its float conversion: a hash of (i, p) as a 32-bit

@@ -105,7 +105,7 @@ pub fn owen_scramble(v: u32, seed: u32) -> u32 {
 /// [`owen_scramble`] on bit-reversed input and output (the sampler keeps values reversed
 /// where it can, to save reversals).
 #[inline]
-fn scramble_reversed(v: u32, seed: u32) -> u32 {
+pub(super) fn scramble_reversed(v: u32, seed: u32) -> u32 {
     scramble_premixed(premix(v), seed)
 }
 
