@@ -74,6 +74,26 @@ const SOBOL_DIM1_REV: [[u32; 256]; 4] = {
     t
 };
 
+/// The second dimension's matrix by bytes of the *bit-reversed* index:
+/// `SOBOL_DIM1_BY_REVERSED[k][b]` is the point of index `(b << 8k).reverse_bits()`, so the
+/// point of index `i` is four lookups on the bytes of `i.reverse_bits()`, which is what
+/// the sampler's shuffle yields (before its reversal).
+const SOBOL_DIM1_BY_REVERSED: [[u32; 256]; 4] = {
+    let mut t = [[0u32; 256]; 4];
+    let mut k = 0;
+    while k < 4 {
+        let mut b = 0;
+        while b < 256 {
+            // (b << 8k) reversed is (b as u8) reversed, shifted to byte 3 − k.
+            let r = (b as u8).reverse_bits() as usize;
+            t[k][b] = SOBOL_DIM1_REV[3 - k][r].reverse_bits();
+            b += 1;
+        }
+        k += 1;
+    }
+    t
+};
+
 /// Point `index` of the first two Sobol' dimensions, as 32-bit fractions.
 pub fn sobol_2d(index: u32) -> (u32, u32) {
     (
@@ -90,6 +110,16 @@ fn sobol_dim1_reversed(index: u32) -> u32 {
         ^ SOBOL_DIM1_REV[1][b[1] as usize]
         ^ SOBOL_DIM1_REV[2][b[2] as usize]
         ^ SOBOL_DIM1_REV[3][b[3] as usize]
+}
+
+/// The second coordinate of point `reversed.reverse_bits()` (not reversed).
+#[inline]
+fn sobol_dim1_of_reversed(reversed: u32) -> u32 {
+    let b = reversed.to_le_bytes();
+    SOBOL_DIM1_BY_REVERSED[0][b[0] as usize]
+        ^ SOBOL_DIM1_BY_REVERSED[1][b[1] as usize]
+        ^ SOBOL_DIM1_BY_REVERSED[2][b[2] as usize]
+        ^ SOBOL_DIM1_BY_REVERSED[3][b[3] as usize]
 }
 
 /// A nested uniform (Owen) scramble of a 32-bit fraction by a hash: each bit is flipped by
@@ -156,8 +186,8 @@ impl SobolSampler {
         }
     }
 
-    /// The next request's hash (splitmix64's sequence from the pixel's key) and its
-    /// shuffled index `owen_scramble(index, low half of the hash)`.
+    /// The next request's shuffled index `owen_scramble(index, low half of the hash)`,
+    /// bit-reversed, and its hash (splitmix64's sequence from the pixel's key).
     #[inline]
     fn next_request(&mut self, width: u32) -> (u32, u64) {
         let r = self.request_at(self.dimension);
@@ -173,8 +203,7 @@ impl SobolSampler {
             self.pixel_key
                 .wrapping_add((dimension as u64).wrapping_mul(GOLDEN)),
         );
-        let shuffled = scramble_premixed(self.index_premixed, h as u32).reverse_bits();
-        (shuffled, h)
+        (scramble_premixed(self.index_premixed, h as u32), h)
     }
 
     /// Requests taken so far in the current pixel sample (a 2D request counts two).
@@ -189,11 +218,12 @@ impl SobolSampler {
         self.pixel_key
     }
 
-    /// The 1D number of request `(i, h)`.
+    /// The 1D number of request `(i_reversed, h)`.
     #[inline(always)]
-    fn number_1d((i, h): (u32, u64)) -> f32 {
+    fn number_1d((i_reversed, h): (u32, u64)) -> f32 {
         // The first coordinate of point i is reverse(i); its scramble works on reverse of
         // that, i itself.
+        let i = i_reversed.reverse_bits();
         to_unit(scramble_reversed(i, (h >> 32) as u32).reverse_bits())
     }
 }
@@ -240,9 +270,14 @@ impl Sampler for SobolSampler {
 
     #[inline]
     fn get_2d(&mut self) -> Vec2 {
-        let (i, h) = self.next_request(2);
-        let x = scramble_reversed(i, (h >> 32) as u32);
-        let y = scramble_reversed(sobol_dim1_reversed(i), y_seed(h));
+        let (i_reversed, h) = self.next_request(2);
+        // The point's coordinates bit-reversed, which the scrambles take: reverse(i)'s
+        // reversal, i, and the second coordinate's. Both come from the shuffled index
+        // before its reversal and are reversed together (one vector op in the v3 loop).
+        let x_in = i_reversed.reverse_bits();
+        let y_in = sobol_dim1_of_reversed(i_reversed).reverse_bits();
+        let x = scramble_reversed(x_in, (h >> 32) as u32);
+        let y = scramble_reversed(y_in, y_seed(h));
         Vec2::new(to_unit(x.reverse_bits()), to_unit(y.reverse_bits()))
     }
 }
@@ -294,6 +329,15 @@ mod tests {
                 }
             }
             assert_eq!(sobol_2d(i).1, y, "index {i}");
+        }
+    }
+
+    #[test]
+    fn lookup_by_reversed_index_equals_the_generator_matrix() {
+        let mut rng = super::super::Pcg32::new(4, 5);
+        for r in (0..4096).chain((0..4096).map(|_| rng.next_u32())) {
+            let i = r.reverse_bits();
+            assert_eq!(sobol_dim1_of_reversed(r), sobol_2d(i).1, "index {i}");
         }
     }
 
