@@ -762,3 +762,122 @@ fn normal_maps_shade_mirrored_uv_halves_with_the_right_bitangent() {
         }
     }
 }
+
+#[test]
+fn accessors_of_a_wrong_format_count_or_stride_are_errors_not_panics() {
+    // Each edit makes an accessor that the `gltf` crate's readers would panic on
+    // (unreachable!, an assertion, an underflow) or silently misread.
+    let mut base = Glb::new();
+    let q = base.quad(0);
+    base.material(json!({}));
+    let mesh = base.mesh(vec![q]);
+    base.node(json!({ "mesh": mesh }), true);
+    // Accessors of the quad: 0 POSITION, 1 NORMAL, 2 TEXCOORD_0, 3 indices.
+    let cases: Vec<(&str, Edit)> = vec![
+        (
+            "indices: accessors[3] holds Scalar of F32",
+            Box::new(|g| g.json["accessors"][3]["componentType"] = json!(5126)),
+        ),
+        (
+            "indices: accessors[3] holds Vec2 of U32",
+            Box::new(|g| {
+                g.json["accessors"][3]["type"] = json!("VEC2");
+                g.json["accessors"][3]["count"] = json!(3);
+            }),
+        ),
+        (
+            "POSITION: accessors[0] holds Vec3 of U16",
+            Box::new(|g| g.json["accessors"][0]["componentType"] = json!(5123)),
+        ),
+        (
+            "NORMAL: accessors[1] holds Vec2 of F32",
+            Box::new(|g| g.json["accessors"][1]["type"] = json!("VEC2")),
+        ),
+        (
+            "TEXCOORD_0: accessors[2] holds Vec2 of I8",
+            Box::new(|g| g.json["accessors"][2]["componentType"] = json!(5120)),
+        ),
+        (
+            "POSITION: accessors[0]: buffer view 0 has byteStride 4 < the element's 12 bytes",
+            Box::new(|g| g.json["bufferViews"][0]["byteStride"] = json!(4)),
+        ),
+        (
+            "POSITION: accessors[0] has count 0",
+            Box::new(|g| g.json["accessors"][0]["count"] = json!(0)),
+        ),
+        (
+            "indices: accessors[3] has count 0",
+            Box::new(|g| g.json["accessors"][3]["count"] = json!(0)),
+        ),
+        (
+            "POSITION: accessors[0]: sparse count is 0",
+            Box::new(|g| {
+                g.json["accessors"][0]["sparse"] = json!({"count": 0,
+                    "indices": {"bufferView": 3, "componentType": 5125},
+                    "values": {"bufferView": 0}})
+            }),
+        ),
+    ];
+    for (want, edit) in cases {
+        let mut g = Glb {
+            json: base.json.clone(),
+            bin: base.bin.clone(),
+        };
+        edit(&mut g);
+        let e = parse(&g).map(|_| ()).unwrap_err();
+        assert!(
+            e.starts_with("t.glb: meshes[0].primitives[0]: ") && e.contains(want),
+            "expected \"{want}\" in: {e}"
+        );
+    }
+}
+
+#[test]
+fn sparse_accessors_override_a_base_view_or_zeros() {
+    // Sparse POSITION data: over the quad's own view, and without a view (zeros, glTF
+    // 2.0 §3.6.2.3), replacing vertices 1 and 2 with (5, 0, 0) and (5, 5, 0).
+    for base_view in [true, false] {
+        let mut g = Glb::new();
+        let q = g.quad(0);
+        g.material(json!({}));
+        let idx = g.view(
+            &[1u16, 2]
+                .iter()
+                .flat_map(|i| i.to_le_bytes())
+                .collect::<Vec<_>>(),
+        );
+        let values: Vec<u8> = [5f32, 0., 0., 5., 5., 0.]
+            .iter()
+            .flat_map(|f| f.to_le_bytes())
+            .collect();
+        let vals = g.view(&values);
+        let a = &mut g.json["accessors"][0];
+        a["sparse"] = json!({"count": 2,
+            "indices": {"bufferView": idx, "componentType": 5123},
+            "values": {"bufferView": vals}});
+        if !base_view {
+            a.as_object_mut().unwrap().remove("bufferView");
+        }
+        let mesh = g.mesh(vec![q]);
+        g.node(json!({ "mesh": mesh }), true);
+        let desc = parse(&g).unwrap().desc;
+        let GeometryDesc::Mesh(m) = &desc.shapes[0].geometry else {
+            panic!("not a mesh")
+        };
+        let corner = if base_view {
+            [Vec3::new(-1., -1., 0.), Vec3::new(-1., 1., 0.)]
+        } else {
+            [Vec3::ZERO; 2]
+        };
+        assert_eq!(
+            m.positions,
+            vec![
+                corner[0],
+                Vec3::new(5., 0., 0.),
+                Vec3::new(5., 5., 0.),
+                corner[1]
+            ],
+            "base view {base_view}"
+        );
+    }
+}

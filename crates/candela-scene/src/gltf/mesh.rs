@@ -22,6 +22,7 @@ use std::sync::Arc;
 
 use candela_core::desc::{GeometryDesc, MeshDesc, ShapeDesc};
 use glam::{Mat4, Vec2, Vec3, Vec4};
+use gltf::accessor::{DataType, Dimensions};
 use gltf::mesh::Mode;
 
 use super::material::Materials;
@@ -77,7 +78,10 @@ pub(crate) fn place_mesh(
 fn unreadable(ctx: &Ctx, path: &str, what: &str, accessor: &gltf::Accessor) -> LoadError {
     let detail = match accessor.view() {
         None if accessor.sparse().is_none() => "has no buffer view".to_string(),
-        None => "is sparse without a base view, which Candela does not read".to_string(),
+        None => format!(
+            "accessor {}'s sparse indices or values read past the end of their buffer views",
+            accessor.index()
+        ),
         Some(v) => format!(
             "accessor {} reads past the end of buffer view {} or buffer {}",
             accessor.index(),
@@ -86,6 +90,58 @@ fn unreadable(ctx: &Ctx, path: &str, what: &str, accessor: &gltf::Accessor) -> L
         ),
     };
     ctx.error(path, format!("{what}: {detail}"))
+}
+
+/// The element formats glTF 2.0 §3.7.2.1 allows for each attribute the importer reads
+/// (KHR_mesh_quantization's others are refused with the extension).
+const FLOAT: &[DataType] = &[DataType::F32];
+const FLOAT_OR_UNORM: &[DataType] = &[DataType::F32, DataType::U8, DataType::U16];
+const INDEX: &[DataType] = &[DataType::U8, DataType::U16, DataType::U32];
+
+/// Checks what the `gltf` crate's readers assume without checking (they panic or misread
+/// otherwise): the element format, a non-zero count, and strides no shorter than an
+/// element.
+fn check_accessor(
+    ctx: &Ctx,
+    path: &str,
+    what: &str,
+    accessor: &gltf::Accessor,
+    dims: &[Dimensions],
+    types: &[DataType],
+) -> Result<(), LoadError> {
+    let at = format!("{what}: accessors[{}]", accessor.index());
+    let (d, t) = (accessor.dimensions(), accessor.data_type());
+    if !dims.contains(&d) || !types.contains(&t) {
+        return Err(ctx.error(
+            path,
+            format!("{at} holds {d:?} of {t:?}; glTF allows {dims:?} of {types:?} here"),
+        ));
+    }
+    if accessor.count() == 0 {
+        return Err(ctx.error(path, format!("{at} has count 0 (at least 1 is required)")));
+    }
+    let short = |view: gltf::buffer::View, size: usize| {
+        view.stride().filter(|&s| s < size).map(|s| {
+            format!(
+                "buffer view {} has byteStride {s} < the element's {size} bytes",
+                view.index()
+            )
+        })
+    };
+    let mut problem = accessor.view().and_then(|v| short(v, accessor.size()));
+    if let Some(sparse) = accessor.sparse() {
+        if sparse.count() == 0 {
+            return Err(ctx.error(path, format!("{at}: sparse count is 0 (at least 1)")));
+        }
+        let indices = sparse.indices();
+        problem = problem
+            .or_else(|| short(indices.view(), indices.index_type().size()))
+            .or_else(|| short(sparse.values().view(), accessor.size()));
+    }
+    match problem {
+        Some(p) => Err(ctx.error(path, format!("{at}: {p}"))),
+        None => Ok(()),
+    }
 }
 
 /// The primitive as a mesh in object space, or `None` where it has no triangles.
@@ -109,6 +165,32 @@ fn read_primitive(
     let Some(pos_accessor) = prim.get(&gltf::Semantic::Positions) else {
         return Err(ctx.error(path, "has no POSITION attribute"));
     };
+    use Dimensions::{Scalar, Vec2 as V2, Vec3 as V3, Vec4 as V4};
+    let attribute = |s: gltf::Semantic| prim.get(&s).map(|a| (s, a));
+    for (semantic, a) in [
+        attribute(gltf::Semantic::Positions),
+        attribute(gltf::Semantic::Normals),
+        attribute(gltf::Semantic::TexCoords(tex_coord)),
+        attribute(gltf::Semantic::Colors(0)),
+    ]
+    .into_iter()
+    .flatten()
+    .chain(
+        normal_map
+            .then(|| attribute(gltf::Semantic::Tangents))
+            .flatten(),
+    ) {
+        let (dims, types): (&[Dimensions], _) = match semantic {
+            gltf::Semantic::Positions | gltf::Semantic::Normals => (&[V3], FLOAT),
+            gltf::Semantic::Tangents => (&[V4], FLOAT),
+            gltf::Semantic::TexCoords(_) => (&[V2], FLOAT_OR_UNORM),
+            _ => (&[V3, V4], FLOAT_OR_UNORM),
+        };
+        check_accessor(ctx, path, &semantic.to_string(), &a, dims, types)?;
+    }
+    if let Some(a) = prim.indices() {
+        check_accessor(ctx, path, "indices", &a, &[Scalar], INDEX)?;
+    }
     let positions: Vec<Vec3> = match reader.read_positions() {
         Some(it) => it.map(Vec3::from).collect(),
         None => return Err(unreadable(ctx, path, "POSITION", &pos_accessor)),
