@@ -763,6 +763,84 @@ fn normal_maps_shade_mirrored_uv_halves_with_the_right_bitangent() {
     }
 }
 
+/// The mean radiance seen from (0, 0, 3) looking down −z at an emissive quad in z = 0
+/// wound clockwise as seen from there (its front faces −z in object space), with
+/// `normals` −z or none, placed by `node` (a node's JSON without its mesh).
+fn seen_emission(node: serde_json::Value, normals: bool) -> f32 {
+    let mut g = Glb::new();
+    let m = g.material(json!({"emissiveFactor": [1.0, 1.0, 1.0],
+        "pbrMetallicRoughness": {"baseColorFactor": [0.0, 0.0, 0.0, 1.0]}}));
+    let mut q = g.quad(m);
+    let pos = g.floats(
+        &[-1., -1., 0., -1., 1., 0., 1., 1., 0., 1., -1., 0.],
+        3,
+        "VEC3",
+    );
+    q["attributes"]["POSITION"] = json!(pos);
+    let attributes = q["attributes"].as_object_mut().unwrap();
+    attributes.remove("TEXCOORD_0");
+    if normals {
+        let n = g.floats(
+            &[0., 0., -1., 0., 0., -1., 0., 0., -1., 0., 0., -1.],
+            3,
+            "VEC3",
+        );
+        q["attributes"]["NORMAL"] = json!(n);
+    } else {
+        attributes.remove("NORMAL");
+    }
+    let mesh = g.mesh(vec![q]);
+    let mut node = node;
+    node["mesh"] = json!(mesh);
+    g.node(node, true);
+    g.json["cameras"] = json!([{"type": "perspective", "perspective": {"yfov": 0.1, "aspectRatio": 1.0, "znear": 0.1}}]);
+    g.node(json!({"camera": 0, "translation": [0.0, 0.0, 3.0]}), true);
+    let mut desc = parse(&g).unwrap().desc;
+    desc.render.width = 4;
+    desc.render.height = 4;
+    desc.render.spp = 1;
+    desc.render.max_depth = 0;
+    let scene = candela_core::build::build(&desc).unwrap();
+    let r = candela_core::integrator::render(&scene, 0..1, &AtomicBool::new(false), &|_| {});
+    let px = r.film.resolve();
+    px.iter().map(|p| p.x).sum::<f32>() / px.len() as f32
+}
+
+#[test]
+fn mirroring_transforms_reverse_the_winding_of_the_front_face() {
+    // glTF 2.0 §3.7.2.1: under a transform of negative determinant the front faces are
+    // the clockwise ones. The quad's object-space front is −z (away from the camera):
+    // mirrored in z it faces the camera, mirrored in x it still faces away. Shading
+    // normals must agree with the winding rule. The emitter shows radiance 1 or 0, so
+    // any threshold between separates them; ½ is the middle.
+    let flip_z = [
+        1., 0., 0., 0., 0., 1., 0., 0., 0., 0., -1., 0., 0., 0., 0., 1.,
+    ];
+    let flip_x = [
+        -1., 0., 0., 0., 0., 1., 0., 0., 0., 0., 1., 0., 0., 0., 0., 1.,
+    ];
+    for normals in [false, true] {
+        for (what, node, faces_camera) in [
+            ("unmirrored", json!({}), false),
+            ("scale z −1", json!({"scale": [1.0, 1.0, -1.0]}), true),
+            ("matrix z −1", json!({ "matrix": flip_z }), true),
+            ("matrix x −1", json!({ "matrix": flip_x }), false),
+            (
+                "scale x −1, y −1",
+                json!({"scale": [-1.0, -1.0, 1.0]}),
+                false,
+            ),
+        ] {
+            let l = seen_emission(node, normals);
+            assert_eq!(
+                l > 0.5,
+                faces_camera,
+                "{what}, normals {normals}: radiance {l}"
+            );
+        }
+    }
+}
+
 #[test]
 fn accessors_of_a_wrong_format_count_or_stride_are_errors_not_panics() {
     // Each edit makes an accessor that the `gltf` crate's readers would panic on

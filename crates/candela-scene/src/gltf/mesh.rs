@@ -61,12 +61,16 @@ pub(crate) fn place_mesh(
             }
         };
         if let Some(desc) = desc {
+            // A mirroring transform makes the front faces clockwise (glTF 2.0 §3.7.2.1).
+            // The renderer takes the front from the winding of the world-space vertices,
+            // which a mirror reverses; shading normals, where given, already decide it.
+            let flip_normals = world.determinant() < 0.0 && desc.normals.is_empty();
             out.shapes.push(ShapeDesc {
                 geometry: GeometryDesc::Mesh(desc),
                 material: mat.name.clone(),
                 emission: mat.emission,
                 transform: world,
-                flip_normals: false,
+                flip_normals,
                 span: ctx.span(),
             });
         }
