@@ -125,7 +125,6 @@ impl GoniometricTable {
             return Err(PhotometryError(format!("candela value {c} is not >= 0")));
         }
         let symmetry = HorizontalSymmetry::classify(horizontal_deg)?;
-        let planes = expand_planes(horizontal_deg, symmetry);
         let columns: Vec<&[f64]> = candela.chunks(nv).collect();
         // Identical planes (e.g. only 0° and 360°) are rotational symmetry in disguise.
         let rotational = columns.iter().all(|c| *c == columns[0]);
@@ -135,17 +134,13 @@ impl GoniometricTable {
         } else {
             grid_cells(horizontal_deg, 360.0, 360, 720)
         };
-        // For each φ knot: the two planes around it and the weight of the second.
+        // For each φ knot: the two measured planes around it and the weight of the second.
         let phi_weights: Vec<(usize, usize, f64)> = (0..n_phi)
             .map(|j| {
-                let phi = 360.0 * j as f64 / n_phi as f64;
-                match planes.iter().position(|&(a, _)| a >= phi - 1e-9) {
-                    _ if rotational => (0, 0, 0.0),
-                    Some(0) | None => (planes[0].1, planes[0].1, 0.0),
-                    Some(k) => {
-                        let ((a0, h0), (a1, h1)) = (planes[k - 1], planes[k]);
-                        (h0, h1, (phi - a0) / (a1 - a0))
-                    }
+                if rotational {
+                    (0, 0, 0.0)
+                } else {
+                    plane_weights(horizontal_deg, symmetry, 360.0 * j as f64 / n_phi as f64)
                 }
             })
             .collect();
@@ -400,30 +395,48 @@ fn interpolate_vertical(vertical: &[f64], column: &[f64], theta: f64) -> f64 {
     (1.0 - t) * column[k - 1] + t * column[k]
 }
 
-/// The measured planes mirrored over the full circle: increasing (angle, column) pairs from
-/// 0° to 360° inclusive.
-fn expand_planes(horizontal: &[f64], symmetry: HorizontalSymmetry) -> Vec<(f64, usize)> {
-    let mut planes: Vec<(f64, usize)> = Vec::new();
-    for (h, &a) in horizontal.iter().enumerate() {
-        let mirrors: &[f64] = match symmetry {
-            HorizontalSymmetry::Rotational => &[0.0, 360.0],
-            HorizontalSymmetry::Quadrant => &[a, 180.0 - a, 180.0 + a, 360.0 - a],
-            HorizontalSymmetry::BilateralC0 => &[a, 360.0 - a],
-            // 180° − a, taken into [0°, 360°).
-            HorizontalSymmetry::BilateralC90 => &[a, (540.0 - a) % 360.0],
-            HorizontalSymmetry::None => &[a],
-        };
-        planes.extend(mirrors.iter().map(|&m| (m, h)));
-    }
-    planes.sort_by(|a, b| a.0.total_cmp(&b.0));
-    planes.dedup_by(|a, b| (a.0 - b.0).abs() < 1e-9);
-    // Close the circle: 0° and 360° are the same plane.
-    if planes[0].0 > 1e-9 {
-        let last = *planes.last().expect("at least one plane");
-        planes.insert(0, (0.0, last.1));
-    }
-    if planes.last().expect("at least one plane").0 < 360.0 - 1e-9 {
-        planes.push((360.0, planes[0].1));
-    }
-    planes
+/// The measured planes around the horizontal angle `phi` (degrees, 0–360) and the weight
+/// of the second: `phi` is folded by the symmetry into the measured range, where the
+/// intensity is linear between planes. Folding, rather than mirroring the planes over the
+/// circle, keeps the data's interpolation across a mirror plane the file did not measure
+/// (e.g. 180° of a 90–270° file in 20° steps, where I(0°) = I(180°) lies halfway between
+/// the 170° and 190° planes).
+fn plane_weights(
+    horizontal: &[f64],
+    symmetry: HorizontalSymmetry,
+    phi: f64,
+) -> (usize, usize, f64) {
+    let n = horizontal.len();
+    let a = match symmetry {
+        HorizontalSymmetry::Rotational => return (0, 0, 0.0),
+        HorizontalSymmetry::Quadrant => match phi {
+            p if p <= 90.0 => p,
+            p if p <= 180.0 => 180.0 - p,
+            p if p <= 270.0 => p - 180.0,
+            p => 360.0 - p,
+        },
+        HorizontalSymmetry::BilateralC0 => phi.min(360.0 - phi),
+        // I(φ) = I(180° − φ), taken into 90–270°.
+        HorizontalSymmetry::BilateralC90 => match phi {
+            p if p < 90.0 => 180.0 - p,
+            p if p > 270.0 => 540.0 - p,
+            p => p,
+        },
+        HorizontalSymmetry::None => {
+            let last = horizontal[n - 1];
+            if phi > last {
+                // Past the last plane the circle closes on the first (0° = 360°).
+                let t = if last < 360.0 {
+                    (phi - last) / (360.0 - last)
+                } else {
+                    0.0
+                };
+                return (n - 1, 0, t.clamp(0.0, 1.0));
+            }
+            phi
+        }
+    };
+    let k = horizontal.partition_point(|&h| h < a).clamp(1, n - 1);
+    let (h0, h1) = (horizontal[k - 1], horizontal[k]);
+    (k - 1, k, ((a - h0) / (h1 - h0)).clamp(0.0, 1.0))
 }

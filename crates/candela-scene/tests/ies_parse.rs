@@ -289,3 +289,60 @@ fn degenerate_input_never_panics() {
     let junk: Vec<u8> = (0..=255u8).cycle().take(2000).collect();
     assert!(parse_ies(&junk, "bad.ies").is_err());
 }
+
+#[test]
+fn bilateral_c90_files_without_a_180_plane_fold_through_it() {
+    // I(φ) = I(180° − φ) about the C90–C270 plane. Where the file has no 180° plane the
+    // intensity there, and so at 0°, lies on the line between the planes around 180°:
+    // halfway between 170° and 190° (20° steps), or between 90° and 270° (two planes).
+    // Plane k has 10 (k + 1) at 45° from nadir.
+    for step in [20usize, 180] {
+        let angles: Vec<usize> = (90..=270).step_by(step).collect();
+        let n = angles.len();
+        let values: String = (0..n)
+            .map(|k| format!("{} {} 0\n", 20 * (k + 1), 10 * (k + 1)))
+            .collect();
+        let list: Vec<String> = angles.iter().map(|a| a.to_string()).collect();
+        let text = file(
+            "IES:LM-63-2019",
+            &format!(
+                "1 -1 1 3 {n} 1 2 0 0 0\n1 1 0\n0 45 90\n{}\n{values}",
+                list.join(" ")
+            ),
+        );
+        let ies = parse(&text);
+        assert_eq!(ies.symmetry(), HorizontalSymmetry::BilateralC90);
+        let table = ies.table().unwrap();
+        let at = |phi: f64| {
+            let p = phi.to_radians();
+            let s = std::f64::consts::FRAC_1_SQRT_2;
+            table.intensity(glam::Vec3::new(
+                (s * p.cos()) as f32,
+                (s * p.sin()) as f32,
+                s as f32,
+            ))
+        };
+        // The mean of the two planes around 180°: 10 (k + 1) for k = n/2 − 1 and n/2.
+        let at_180 = 10.0 * (n as f32 + 1.0) / 2.0;
+        for (phi, want) in [
+            (90.0, 10.0),
+            (270.0, 10.0 * n as f32),
+            (180.0, at_180),
+            (0.0, at_180),
+        ] {
+            assert!(
+                (at(phi) - want).abs() < 1e-3,
+                "step {step}: I({phi}°) = {}, expected {want}",
+                at(phi)
+            );
+        }
+        for (a, b) in [(45.0, 135.0), (10.0, 170.0), (315.0, 225.0), (350.0, 190.0)] {
+            assert!(
+                (at(a) - at(b)).abs() < 1e-3,
+                "step {step}: I({a}°) = {} but I({b}°) = {}",
+                at(a),
+                at(b)
+            );
+        }
+    }
+}
