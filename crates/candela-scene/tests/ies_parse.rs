@@ -346,3 +346,31 @@ fn bilateral_c90_files_without_a_180_plane_fold_through_it() {
         }
     }
 }
+
+#[test]
+fn byte_order_marks_and_classic_mac_line_ends_are_read() {
+    let lf = file("IESNA:LM-63-2002\n[TEST] 1", SIMPLE);
+    let plain = parse(&lf);
+    assert_eq!(plain.version, IesVersion::Lm63_2002);
+    // A UTF-8 byte-order mark before the version line: still LM-63-2002 (and so the
+    // third ballast number is not applied).
+    let bom = parse(&format!("\u{feff}{lf}"));
+    assert_eq!(bom.version, IesVersion::Lm63_2002);
+    assert_eq!(bom.candela, plain.candela);
+    // Lone CR line ends, and CR LF with tabs and trailing blank lines.
+    assert_eq!(parse(&lf.replace('\n', "\r")), plain);
+    let crlf = lf.replace('\n', "\r\n").replace(' ', "\t") + "\r\n\r\n  \r\n";
+    assert_eq!(parse(&crlf).candela, plain.candela);
+}
+
+#[test]
+fn missing_values_point_just_past_the_last_one() {
+    // Two planes announced, one given: the error is at line 8, just after the last "0".
+    let text = file(
+        "IES:LM-63-2019\n[TEST] 1",
+        "1 1000 1 3 2 1 2 0 0 0\n1 1 50\n0 45 90\n0 90\n100 80 0",
+    );
+    let (shown, line) = error(&text);
+    assert_eq!(line, 8, "{shown}");
+    assert!(shown.starts_with("bad.ies:8:9: truncated data"), "{shown}");
+}

@@ -142,9 +142,10 @@ pub fn parse_ies(bytes: &[u8], file: &str) -> Result<IesFile, LoadError> {
          {expected} numbers after the header"
     );
     if found < expected {
+        let (line, col) = tokens.end();
         return Err(err(
-            tokens.end_line(),
-            0,
+            line,
+            col,
             format!("truncated data: {counts}, found {found}"),
         ));
     }
@@ -197,14 +198,17 @@ pub fn parse_ies(bytes: &[u8], file: &str) -> Result<IesFile, LoadError> {
     })
 }
 
-/// Text from bytes: UTF-8 where valid, else Latin-1 (every byte one character). The DOS
-/// end-of-file byte ^Z becomes a space.
+/// Text from bytes: UTF-8 where valid (a byte-order mark dropped), else Latin-1 (every
+/// byte one character). The DOS end-of-file byte ^Z becomes a space, and lines end with
+/// `\n` whether the file ends them with LF, CR LF or a lone CR (classic Mac OS).
 fn decode(bytes: &[u8]) -> String {
     let text = match std::str::from_utf8(bytes) {
-        Ok(s) => s.to_string(),
+        Ok(s) => s.strip_prefix('\u{feff}').unwrap_or(s).to_string(),
         Err(_) => bytes.iter().map(|&b| b as char).collect(),
     };
     text.replace('\u{1a}', " ")
+        .replace("\r\n", "\n")
+        .replace('\r', "\n")
 }
 
 /// Tilt data: lamp geometry, pair count, angles, factors.
@@ -241,12 +245,15 @@ struct Tokens<'a> {
     next: usize,
     /// Last line of the stream, for errors about missing data.
     end_line: usize,
+    /// Column just after the stream's last word on `end_line`.
+    end_col: usize,
 }
 
 impl<'a> Tokens<'a> {
     fn new(file: &'a str, lines: &[&'a str], start: usize) -> Tokens<'a> {
         let mut tokens = Vec::new();
         let mut end_line = start.max(1);
+        let mut end_col = 1;
         'lines: for (i, line) in lines.iter().enumerate().skip(start) {
             let mut offset = 0;
             for word in line.split(|c: char| c.is_whitespace() || c == ',') {
@@ -264,6 +271,7 @@ impl<'a> Tokens<'a> {
                     col,
                 });
                 end_line = i + 1;
+                end_col = col + word.len();
             }
         }
         Tokens {
@@ -271,6 +279,7 @@ impl<'a> Tokens<'a> {
             tokens,
             next: 0,
             end_line,
+            end_col,
         }
     }
 
@@ -286,8 +295,9 @@ impl<'a> Tokens<'a> {
         self.tokens.len() - self.next
     }
 
-    fn end_line(&self) -> usize {
-        self.end_line
+    /// Where data is missing: just after the last word.
+    fn end(&self) -> (usize, usize) {
+        (self.end_line, self.end_col)
     }
 
     /// Line of the token read last.
@@ -305,7 +315,7 @@ impl<'a> Tokens<'a> {
     fn number(&mut self, what: &str) -> Result<(f64, usize), LoadError> {
         let Some(t) = self.tokens.get(self.next) else {
             return Err(LoadError {
-                span: Span::new(self.file, self.end_line as u32, 0),
+                span: Span::new(self.file, self.end_line as u32, self.end_col as u32),
                 message: format!("truncated data: expected {what}, found the end of the file"),
             });
         };
