@@ -1,5 +1,6 @@
-//! Image textures: PNG, JPEG, TGA and BMP through `image`, Radiance HDR through `image`,
-//! OpenEXR through `exr`, decoded once to linear RGB ([`ImageDesc`]).
+//! Image textures: PNG, JPEG, TGA and BMP through `image`, Radiance HDR through `image`
+//! (top-down `-Y` files, and bottom-up `+Y` ones turned upright), OpenEXR through `exr`,
+//! decoded once to linear RGB ([`ImageDesc`]).
 //!
 //! Integer images are encoded: a colour texture is decoded with the exact sRGB EOTF
 //! (IEC 61966-2-1, [`srgb_decode`]) unless the scene asks for a pure power law
@@ -104,6 +105,40 @@ pub(crate) fn decode_guessed(bytes: &[u8]) -> Result<image::DynamicImage, String
 /// the declared dimensions checked first (the decoder's limit does not count Candela's
 /// conversions).
 fn decode_with_image(
+    bytes: &[u8],
+    format: image::ImageFormat,
+) -> Result<image::DynamicImage, String> {
+    let bottom_up = match format {
+        image::ImageFormat::Hdr => hdr_as_top_down(bytes),
+        _ => None,
+    };
+    let img = decode_top_down(bottom_up.as_deref().unwrap_or(bytes), format)?;
+    Ok(if bottom_up.is_some() {
+        img.flipv()
+    } else {
+        img
+    })
+}
+
+/// A Radiance file that stores its bottom row first (resolution line `+Y h +X w`, which
+/// `image` refuses) as the same bytes with `-Y`: decoded, its rows are then upside down.
+/// `None` for any other orientation (the usual `-Y h +X w`, or the column-major ones,
+/// which `image` reports as unsupported).
+fn hdr_as_top_down(bytes: &[u8]) -> Option<Vec<u8>> {
+    // The header ends at the first empty line; the resolution line follows.
+    let head = &bytes[..bytes.len().min(1 << 16)];
+    let end = head.windows(2).position(|w| w == b"\n\n")? + 2;
+    let at = end + bytes[end..].iter().take_while(|&&b| b == b' ').count();
+    if !bytes[at..].starts_with(b"+Y ") {
+        return None;
+    }
+    let mut fixed = bytes.to_vec();
+    fixed[at] = b'-';
+    Some(fixed)
+}
+
+/// [`decode_with_image`] of an image stored top row first.
+fn decode_top_down(
     bytes: &[u8],
     format: image::ImageFormat,
 ) -> Result<image::DynamicImage, String> {

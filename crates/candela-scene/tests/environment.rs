@@ -172,6 +172,54 @@ fn exr_half_and_float_and_hdr_files_load_as_linear() {
     }
 }
 
+/// A flat (uncompressed) Radiance file of 2 × 3 pixels with the resolution line
+/// `resolution` (`-Y 3 +X 2` top row first, `+Y 3 +X 2` bottom row first), an exposure
+/// line and a comment. Pixel (x, y), y from the top, is 2^(x + 2y) in red, ¼ of it in green, 0 blue:
+/// RGBE (128, 32, 0, 129 + x + 2y) holds it exactly.
+fn flat_hdr(resolution: &str) -> Vec<u8> {
+    let mut out = format!(
+        "#?RADIANCE\n# written by hand\nFORMAT=32-bit_rle_rgbe\nEXPOSURE=1.0\n\n{resolution}\n"
+    )
+    .into_bytes();
+    let rows: Vec<u32> = if resolution.contains("+Y") {
+        vec![2, 1, 0]
+    } else {
+        vec![0, 1, 2]
+    };
+    for y in rows {
+        for x in 0..2 {
+            out.extend_from_slice(&[128, 32, 0, (129 + x + 2 * y) as u8]);
+        }
+    }
+    out
+}
+
+#[test]
+fn radiance_files_stored_bottom_row_first_load_upright() {
+    // Radiance's `+Y h +X w` stores the bottom scanline first; `image` reads only `-Y`.
+    // Both must come out top row first, with the same pixels.
+    let dir = tempfile::tempdir().unwrap();
+    for orientation in ["-Y 3 +X 2", "+Y 3 +X 2", " +Y 3 +X 2"] {
+        let path = dir.path().join("o.hdr");
+        std::fs::write(&path, flat_hdr(orientation)).unwrap();
+        let img = load_linear_image(&path).unwrap_or_else(|e| panic!("{orientation}: {e}"));
+        assert_eq!((img.width, img.height), (2, 3), "{orientation}");
+        for y in 0..3 {
+            for x in 0..2 {
+                let v = 2f32.powi((x + 2 * y) as i32);
+                let want = Vec3::new(v, v / 4.0, 0.0);
+                let got = img.pixels[(y * 2 + x) as usize];
+                assert_eq!(got, want, "{orientation} ({x},{y})");
+            }
+        }
+    }
+    // Column-major orientations stay a clear error.
+    let path = dir.path().join("c.hdr");
+    std::fs::write(&path, flat_hdr("+X 2 -Y 3")).unwrap();
+    let e = load_linear_image(&path).unwrap_err();
+    assert!(e.contains("c.hdr") && e.contains("Orientation"), "{e}");
+}
+
 #[test]
 fn srgb_images_are_decoded_to_linear() {
     let dir = tempfile::tempdir().unwrap();
