@@ -959,3 +959,23 @@ fn sparse_accessors_override_a_base_view_or_zeros() {
         );
     }
 }
+
+#[test]
+fn scenes_without_nodes_load() {
+    // glTF 2.0 §5.17 leaves a scene's `nodes` optional; `gltf-json` 1.4 requires it.
+    let mut g = Glb::new();
+    let q = g.quad(0);
+    g.material(json!({}));
+    let mesh = g.mesh(vec![q]);
+    g.node(json!({ "mesh": mesh }), true);
+    g.json["scenes"] = json!([{"name": "empty"}, {"nodes": [0]}]);
+    g.json["scene"] = json!(1);
+    let desc = parse(&g).unwrap().desc;
+    assert_eq!(desc.shapes.len(), 1);
+    g.json["scene"] = json!(0);
+    assert!(parse(&g).unwrap().desc.shapes.is_empty());
+    // Other missing data is still an error (here a scene's node list of the wrong type).
+    g.json["scenes"] = json!([{"nodes": 0}]);
+    let e = parse(&g).unwrap_err();
+    assert!(e.contains("invalid glTF JSON"), "{e}");
+}

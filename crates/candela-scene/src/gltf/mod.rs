@@ -142,6 +142,69 @@ fn check_position_indices(file: &str, root: &gltf::json::Root) -> Result<(), Loa
     Ok(())
 }
 
+/// An error for the first extension in `required` that Candela does not support.
+fn check_required_extensions<'a>(
+    file: &str,
+    required: impl IntoIterator<Item = &'a str>,
+) -> Result<(), LoadError> {
+    match required
+        .into_iter()
+        .find(|ext| !SUPPORTED_EXTENSIONS.contains(ext))
+    {
+        Some(ext) => Err(LoadError::new(
+            Span::new(file, 0, 0),
+            format!(
+                "requires extension {ext}, which Candela does not support (supported: {})",
+                SUPPORTED_EXTENSIONS.join(", ")
+            ),
+        )),
+        None => Ok(()),
+    }
+}
+
+/// Reads the document (JSON, or GLB with its binary chunk) without validating it. Where
+/// `gltf-json` 1.4 cannot deserialize it, scenes without `nodes`, which glTF 2.0 allows
+/// (§5.17) but the crate does not, get an empty list and the JSON is read once more;
+/// otherwise the first error stands.
+fn read_document(name: &str, bytes: &[u8]) -> Result<gltf::Gltf, LoadError> {
+    let first = match gltf::Gltf::from_slice_without_validation(bytes) {
+        Ok(g) => return Ok(g),
+        Err(e @ gltf::Error::Deserialize(_)) => gltf_error(name, e),
+        Err(e) => return Err(gltf_error(name, e)),
+    };
+    let (json, blob) = if bytes.starts_with(b"glTF") {
+        let Ok(glb) = gltf::Glb::from_slice(bytes) else {
+            return Err(first);
+        };
+        (glb.json.into_owned(), glb.bin.map(|b| b.into_owned()))
+    } else {
+        (bytes.to_vec(), None)
+    };
+    let Ok(mut value) = gltf::json::deserialize::from_slice::<gltf::json::Value>(&json) else {
+        return Err(first);
+    };
+    let mut patched = false;
+    for scene in value
+        .get_mut("scenes")
+        .and_then(|s| s.as_array_mut())
+        .into_iter()
+        .flatten()
+    {
+        if let Some(scene) = scene.as_object_mut().filter(|s| !s.contains_key("nodes")) {
+            scene.insert("nodes".into(), gltf::json::Value::Array(Vec::new()));
+            patched = true;
+        }
+    }
+    if !patched {
+        return Err(first);
+    }
+    let root: gltf::json::Root = gltf::json::deserialize::from_value(value).map_err(|_| first)?;
+    Ok(gltf::Gltf {
+        document: gltf::Document::from_json_without_validation(root),
+        blob,
+    })
+}
+
 /// Parses a glTF or GLB file held in memory into the shapes, materials, lights and
 /// camera of one of its scenes (`options.scene`, else the default, else the first).
 /// External files resolve against `base`; `file` names the source in messages.
@@ -153,20 +216,9 @@ pub fn parse_gltf_scene(
     prefix: &str,
 ) -> Result<GltfScene, LoadError> {
     let name = file.display().to_string();
-    let gltf::Gltf { document, blob } =
-        gltf::Gltf::from_slice_without_validation(bytes).map_err(|e| gltf_error(&name, e))?;
+    let gltf::Gltf { document, blob } = read_document(&name, bytes)?;
+    check_required_extensions(&name, document.extensions_required())?;
     let mut warnings = Vec::new();
-    for ext in document.extensions_required() {
-        if !SUPPORTED_EXTENSIONS.contains(&ext) {
-            return Err(LoadError::new(
-                Span::new(name.as_str(), 0, 0),
-                format!(
-                    "requires extension {ext}, which Candela does not support (supported: {})",
-                    SUPPORTED_EXTENSIONS.join(", ")
-                ),
-            ));
-        }
-    }
     for ext in document.extensions_used() {
         if !SUPPORTED_EXTENSIONS.contains(&ext) {
             warnings.push(format!(
