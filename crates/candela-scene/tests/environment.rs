@@ -206,7 +206,7 @@ fn radiance_files_stored_bottom_row_first_load_upright() {
         assert_eq!((img.width, img.height), (2, 3), "{orientation}");
         for y in 0..3 {
             for x in 0..2 {
-                let v = 2f32.powi((x + 2 * y) as i32);
+                let v = 2f32.powi(x + 2 * y);
                 let want = Vec3::new(v, v / 4.0, 0.0);
                 let got = img.pixels[(y * 2 + x) as usize];
                 assert_eq!(got, want, "{orientation} ({x},{y})");
