@@ -171,8 +171,8 @@ pub fn from_dynamic(img: &image::DynamicImage, encoding: Encoding) -> ImageDesc 
     }
 }
 
-/// Decodes the first RGB(A) layer of an EXR file at its largest resolution level. Every
-/// layer's declared size is checked against the file's budget before its pixels are
+/// Decodes the first RGB(A) layer of an EXR file at its largest resolution level, or a
+/// luminance (`Y`) file as grey. Every layer's declared size is checked against the file's budget before its pixels are
 /// allocated.
 fn decode_exr(bytes: &[u8]) -> Result<ImageDesc, String> {
     use exr::prelude::*;
@@ -181,6 +181,51 @@ fn decode_exr(bytes: &[u8]) -> Result<ImageDesc, String> {
     for header in meta.headers.iter() {
         let size = header.layer_size;
         check_image_size(size.width() as u64, size.height() as u64, bytes.len())?;
+    }
+    // A luminance-only file (one `Y` channel, no R, G, B in any layer) is grey.
+    let has = |h: &exr::meta::header::Header, name: &str| {
+        h.channels
+            .list
+            .iter()
+            .any(|c| c.name.eq_case_insensitive(name))
+    };
+    let rgb = meta
+        .headers
+        .iter()
+        .any(|h| ["R", "G", "B"].iter().all(|c| has(h, c)));
+    if !rgb && meta.headers.iter().any(|h| has(h, "Y")) {
+        let image = read()
+            .no_deep_data()
+            .largest_resolution_level()
+            .specific_channels()
+            .required("Y")
+            .collect_pixels(
+                |res, _| ImageDesc {
+                    width: res.width() as u32,
+                    height: res.height() as u32,
+                    pixels: vec![Vec3::ZERO; res.width() * res.height()],
+                },
+                |img: &mut ImageDesc, pos, (y,): (f32,)| {
+                    let w = img.width as usize;
+                    img.pixels[pos.y() * w + pos.x()] = Vec3::splat(y);
+                },
+            )
+            .first_valid_layer()
+            .all_attributes()
+            .from_buffered(Cursor::new(bytes))
+            .map_err(|e| e.to_string())?;
+        return Ok(image.layer_data.channel_data.pixels);
+    }
+    if !rgb {
+        let names: Vec<String> = meta
+            .headers
+            .iter()
+            .flat_map(|h| h.channels.list.iter().map(|c| c.name.to_string()))
+            .collect();
+        return Err(format!(
+            "no layer has R, G and B channels (nor a luminance Y); channels: {}",
+            names.join(", ")
+        ));
     }
     let image = read()
         .no_deep_data()

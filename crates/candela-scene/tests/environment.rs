@@ -221,6 +221,38 @@ fn radiance_files_stored_bottom_row_first_load_upright() {
 }
 
 #[test]
+fn luminance_only_exr_files_load_as_grey_and_others_name_their_channels() {
+    use exr::prelude::*;
+    let dir = tempfile::tempdir().unwrap();
+    let (w, h) = (4usize, 2usize);
+    let value = |x: usize, y: usize| x as f32 + 10.0 * y as f32;
+    let write = |name: &str, channel: &str| {
+        let path = dir.path().join(name);
+        let pixels = SpecificChannels::build()
+            .with_channel(channel)
+            .with_pixel_fn(|p: Vec2<usize>| (f16::from_f32(value(p.x(), p.y())),));
+        Image::from_channels((w, h), pixels)
+            .write()
+            .to_file(&path)
+            .unwrap();
+        path
+    };
+    // Half floats hold these small integers exactly.
+    let img = load_linear_image(&write("y.exr", "Y")).unwrap();
+    assert_eq!((img.width, img.height), (w as u32, h as u32));
+    for y in 0..h {
+        for x in 0..w {
+            assert_eq!(img.pixels[y * w + x], Vec3::splat(value(x, y)), "({x},{y})");
+        }
+    }
+    let e = load_linear_image(&write("z.exr", "Z")).unwrap_err();
+    assert!(
+        e.contains("z.exr") && e.contains("no layer has R, G and B") && e.contains("channels: Z"),
+        "{e}"
+    );
+}
+
+#[test]
 fn srgb_images_are_decoded_to_linear() {
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("face.png");
