@@ -172,8 +172,8 @@ pub fn from_dynamic(img: &image::DynamicImage, encoding: Encoding) -> ImageDesc 
 }
 
 /// Decodes the first RGB(A) layer of an EXR file at its largest resolution level, or a
-/// luminance (`Y`) file as grey. Every layer's declared size is checked against the file's budget before its pixels are
-/// allocated.
+/// luminance (`Y`) file as grey. Every layer's declared size is checked against the
+/// file's budget before its pixels are allocated.
 fn decode_exr(bytes: &[u8]) -> Result<ImageDesc, String> {
     use exr::prelude::*;
     let meta = exr::meta::MetaData::read_from_buffered(Cursor::new(bytes), false)
