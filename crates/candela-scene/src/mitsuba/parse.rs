@@ -119,6 +119,14 @@ impl Node {
             "float" => Ok(Some(Vec3::splat(p.parse_f32(p.req("value")?)?))),
             "rgb" => p.parse_vec3(p.req("value")?, true).map(Some),
             "spectrum" => {
+                if let Some(t) = p.attr("type") {
+                    // Mitsuba 3.9.1's RGB variants refuse `blackbody` as well ("Not
+                    // implemented for non-spectral modes").
+                    return Err(p.error(format!(
+                        "a <spectrum type=\"{t}\"> is not supported (Candela renders RGB); \
+                         give the colour as <rgb>"
+                    )));
+                }
                 let v = p.req("value")?;
                 if v.contains(':') {
                     return Err(p.error(
@@ -134,6 +142,18 @@ impl Node {
         }
     }
 
+    /// An emitter's colour (`radiance`, `intensity`, `irradiance`): as [`Node::color`],
+    /// except that a constant `<spectrum value="v">` is an equal-energy spectrum of v,
+    /// which Mitsuba's RGB variants turn into v·[`EQUAL_ENERGY_RGB`] where they read it
+    /// as an illuminant (a BSDF's constant spectrum stays v in every channel).
+    pub fn illuminant(&self, name: &str) -> Result<Option<Vec3>, LoadError> {
+        let scale = match self.children.iter().find(|c| c.name() == name) {
+            Some(c) if c.tag == "spectrum" => EQUAL_ENERGY_RGB,
+            _ => Vec3::ONE,
+        };
+        Ok(self.color(name)?.map(|c| c * scale))
+    }
+
     /// A `point` or `vector`: `x`/`y`/`z` attributes (missing ones are 0) or `value`.
     pub fn point(&self, name: &str) -> Result<Option<Vec3>, LoadError> {
         self.prop(name)
@@ -141,7 +161,7 @@ impl Node {
             .transpose()
     }
 
-    fn typed(&self, tags: &[&str]) -> Result<&Node, LoadError> {
+    pub fn typed(&self, tags: &[&str]) -> Result<&Node, LoadError> {
         if tags.contains(&self.tag.as_str()) {
             Ok(self)
         } else {
@@ -188,6 +208,11 @@ impl Node {
         }
     }
 }
+
+/// Linear Rec.709 RGB of the equal-energy spectrum of value 1 as Mitsuba 3.9.1's RGB
+/// variants compute it: `mi.traverse(mi.load_string('<emitter version="3.0.0"
+/// type="point"><spectrum name="intensity" value="1"/></emitter>'))['intensity.value']`.
+pub(crate) const EQUAL_ENERGY_RGB: Vec3 = Vec3::new(1.20479, 0.948291, 0.908916);
 
 /// Elements that are properties of the plugin they sit in.
 pub(crate) fn is_property(tag: &str) -> bool {

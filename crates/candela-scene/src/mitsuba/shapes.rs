@@ -123,6 +123,9 @@ fn shape_desc(ctx: &mut Ctx, node: &Node) -> Result<Option<ShapeDesc>, LoadError
                         .map_err(|e| node.error(format!("cannot load mesh: {e}")))?;
                     if face_normals {
                         mesh.normals.clear();
+                    } else if mesh.normals.is_empty() {
+                        // Mitsuba smooths a mesh that comes without normals.
+                        mesh.normals = vertex_normals(&mesh);
                     }
                     if flip_uv {
                         mesh.uvs.iter_mut().for_each(|uv| uv.y = 1.0 - uv.y);
@@ -161,7 +164,7 @@ fn shape_desc(ctx: &mut Ctx, node: &Node) -> Result<Option<ShapeDesc>, LoadError
         if emission.is_some() {
             return Err(e.error("a shape has at most one area emitter"));
         }
-        emission = Some(e.color("radiance")?.unwrap_or(Vec3::ONE));
+        emission = Some(e.illuminant("radiance")?.unwrap_or(Vec3::ONE));
         ctx.check_unused(e)?;
     }
     ctx.check_unused(node)?;
@@ -225,6 +228,42 @@ fn reads_uv(ctx: &Ctx, material: &str) -> bool {
         .iter()
         .find(|m| m.name == material)
         .is_some_and(|m| bsdf(&m.bsdf))
+}
+
+/// Mitsuba's `Mesh::recompute_vertex_normals`, which its `obj` and `ply` shapes apply to
+/// a mesh without normals unless `face_normals` is set: each vertex gets the sum of its
+/// faces' unit normals weighted by the face's angle at the vertex (Thürmer and Wüthrich
+/// 1998), normalized; a vertex with no valid face gets (1, 0, 0), as in Mitsuba.
+pub(crate) fn vertex_normals(mesh: &MeshDesc) -> Vec<Vec3> {
+    // The angle between unit vectors, accurate near 0 and π (Mitsuba's `unit_angle`).
+    fn unit_angle(a: Vec3, b: Vec3) -> f32 {
+        if a.dot(b) < 0.0 {
+            std::f32::consts::PI - 2.0 * ((a + b).length() * 0.5).min(1.0).asin()
+        } else {
+            2.0 * ((a - b).length() * 0.5).min(1.0).asin()
+        }
+    }
+    let mut normals = vec![Vec3::ZERO; mesh.positions.len()];
+    for &[i0, i1, i2] in &mesh.indices {
+        let [p0, p1, p2] = [i0, i1, i2].map(|i| mesh.positions[i as usize]);
+        let n = (p1 - p0).cross(p2 - p0);
+        if n.length_squared() == 0.0 || !n.is_finite() {
+            continue;
+        }
+        let n = n.normalize();
+        let corners = [
+            (i0, p1 - p0, p2 - p0),
+            (i1, p2 - p1, p0 - p1),
+            (i2, p0 - p2, p1 - p2),
+        ];
+        for (i, a, b) in corners {
+            normals[i as usize] += n * unit_angle(a.normalize(), b.normalize());
+        }
+    }
+    for n in &mut normals {
+        *n = n.try_normalize().unwrap_or(Vec3::X);
+    }
+    normals
 }
 
 /// Rings from pole to pole and segments around the axis of [`uv_sphere`]: the flat
