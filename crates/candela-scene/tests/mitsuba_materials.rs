@@ -587,6 +587,83 @@ fn constant_emitters_and_hidden_emitters() {
 }
 
 #[test]
+fn masks_become_stochastic_alpha_and_normalmaps_get_mitsubas_bitangent() {
+    use candela_core::alpha::AlphaMode;
+    // Mitsuba's `mask` keeps a hit with probability α (default 0.5) around the nested
+    // BSDF, whose sidedness it keeps.
+    let alpha = |b: &BsdfDesc| match b {
+        BsdfDesc::Alpha { alpha, inner } => (alpha.clone(), inner.as_ref().clone()),
+        b => panic!("{b:?}"),
+    };
+    let (a, inner) = alpha(&bsdf(
+        r#"<bsdf type="mask"><float name="opacity" value="0.4"/><bsdf type="diffuse"/></bsdf>"#,
+    ));
+    assert_eq!(
+        (a.mode, a.factor, a.texture.is_none()),
+        (AlphaMode::Blend, 0.4, true)
+    );
+    assert!(matches!(inner, BsdfDesc::OneSided(_)), "{inner:?}");
+    let (a, inner) = alpha(&bsdf(
+        r#"<bsdf type="mask"><bsdf type="twosided"><bsdf type="diffuse"/></bsdf></bsdf>"#,
+    ));
+    assert_eq!(a.factor, 0.5);
+    assert!(matches!(inner, BsdfDesc::Diffuse { .. }), "{inner:?}");
+    let (a, _) = alpha(&bsdf(
+        r#"<bsdf type="mask"><texture type="checkerboard" name="opacity"/><bsdf type="diffuse"/></bsdf>"#,
+    ));
+    assert!(matches!(a.texture, Some(TextureDesc::Checker { .. })) && a.factor == 1.0);
+    let e = load_err(r#"<shape type="cube"><bsdf type="mask"/></shape>"#);
+    assert!(
+        e.contains("scene.xml:2:20:") && e.contains("one nested <bsdf>"),
+        "{e}"
+    );
+
+    // A normal map on an OBJ: Mitsuba's bitangent is n × ∂p/∂u, so the importer gives
+    // the mesh tangents ∂p/∂u with handedness +1 (the OBJ's flipped v would otherwise
+    // flip Candela's bitangent).
+    let obj = "v -1 -1 0\nv 1 -1 0\nv 1 1 0\nv -1 1 0\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\n\
+               f 1/1 2/2 3/3\nf 1/1 3/3 4/4\n";
+    let xml = scene(
+        r#"<shape type="obj"><string name="filename" value="quad.obj"/>
+             <bsdf type="normalmap"><texture type="checkerboard" name="normalmap"/>
+               <bsdf type="diffuse"/></bsdf></shape>
+           <shape type="obj"><string name="filename" value="quad.obj"/></shape>"#,
+    );
+    let desc = load_files(
+        &[("scene.xml", xml.as_bytes()), ("quad.obj", obj.as_bytes())],
+        false,
+    )
+    .unwrap()
+    .desc;
+    match &desc.materials[0].bsdf {
+        BsdfDesc::NormalMap { map, inner } => {
+            assert!(matches!(map, TextureDesc::Checker { .. }));
+            assert!(matches!(inner.as_ref(), BsdfDesc::OneSided(_)), "{inner:?}");
+        }
+        b => panic!("{b:?}"),
+    }
+    let mesh = |i: usize| match &desc.shapes[i].geometry {
+        GeometryDesc::Mesh(m) => m.clone(),
+        g => panic!("{g:?}"),
+    };
+    assert_eq!(
+        mesh(0).tangents,
+        vec![glam::Vec4::new(1.0, 0.0, 0.0, 1.0); 4]
+    );
+    assert!(
+        mesh(1).tangents.is_empty(),
+        "only normal-mapped meshes get tangents"
+    );
+    let e = load_err(
+        r#"<shape type="cube"><bsdf type="normalmap"><bsdf type="diffuse"/></bsdf></shape>"#,
+    );
+    assert!(
+        e.contains("scene.xml:2:20:") && e.contains("normalmap needs"),
+        "{e}"
+    );
+}
+
+#[test]
 fn unknown_plugins_name_themselves() {
     for (body, what) in [
         (

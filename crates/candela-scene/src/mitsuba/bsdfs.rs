@@ -2,8 +2,9 @@
 //! one-sided (black from the back) unless wrapped in `twosided`; Candela's are two-sided,
 //! so an unwrapped one becomes [`BsdfDesc::OneSided`]. Dielectrics are two-sided in both.
 
+use candela_core::alpha::AlphaMode;
 use candela_core::bsdf::metal_preset;
-use candela_core::desc::{BsdfDesc, MaterialDesc, MicrofacetDesc, TextureDesc};
+use candela_core::desc::{AlphaDesc, BsdfDesc, MaterialDesc, MicrofacetDesc, TextureDesc};
 use glam::Vec3;
 
 use super::parse::Node;
@@ -70,6 +71,9 @@ fn bsdf(ctx: &mut Ctx, node: &Node) -> Result<BsdfDesc, LoadError> {
         };
         ctx.check_unused(node)?;
         return Ok(d);
+    }
+    if matches!(node.kind(), "mask" | "normalmap") {
+        return wrapper(ctx, node, bsdf);
     }
     Ok(match two_sided(ctx, node)? {
         d @ (BsdfDesc::Diffuse { .. } | BsdfDesc::Conductor { .. } | BsdfDesc::Plastic { .. }) => {
@@ -139,11 +143,63 @@ fn two_sided(ctx: &mut Ctx, node: &Node) -> Result<BsdfDesc, LoadError> {
                 eta,
             }
         }
+        "mask" | "normalmap" => return wrapper(ctx, node, two_sided),
         "twosided" => return Err(node.error("twosided inside twosided")),
         _ => {
             ctx.unsupported(node, format!("<{}> is not supported", describe(node)))?;
             ctx.warn(node, "using a grey diffuse in its place");
             return Ok(grey());
+        }
+    };
+    ctx.check_unused(node)?;
+    Ok(d)
+}
+
+/// `mask` and `normalmap`, which wrap one nested BSDF (mapped by `inner`, so that it
+/// keeps the sidedness of where the wrapper sits).
+///
+/// - `mask`: Mitsuba's opacity α (default 0.5) lets a ray pass with probability 1 − α,
+///   which is Candela's stochastic alpha ([`AlphaMode::Blend`]); a texture's first
+///   channel is read.
+/// - `normalmap`: Mitsuba's shading normal 2·rgb − 1 in the frame of ∂p/∂u and n × ∂p/∂u,
+///   Candela's tangent-space normal map (x along +u, y along +v) on the same uvs.
+fn wrapper(
+    ctx: &mut Ctx,
+    node: &Node,
+    inner: fn(&mut Ctx, &Node) -> Result<BsdfDesc, LoadError>,
+) -> Result<BsdfDesc, LoadError> {
+    let nested: Vec<&Node> = node.plugins("bsdf").collect();
+    let [one] = nested.as_slice() else {
+        return Err(node.error(format!("{} needs exactly one nested <bsdf>", node.kind())));
+    };
+    let d = if node.kind() == "mask" {
+        let textured = node
+            .children
+            .iter()
+            .any(|c| c.name() == "opacity" && matches!(c.tag.as_str(), "texture" | "ref"));
+        let alpha = match textured {
+            true => AlphaDesc {
+                mode: AlphaMode::Blend,
+                factor: 1.0,
+                texture: Some(ctx.texture(node, "opacity", Vec3::ONE)?),
+            },
+            false => AlphaDesc {
+                mode: AlphaMode::Blend,
+                factor: node.float("opacity")?.unwrap_or(0.5),
+                texture: None,
+            },
+        };
+        BsdfDesc::Alpha {
+            alpha,
+            inner: Box::new(inner(ctx, one)?),
+        }
+    } else {
+        if node.prop("normalmap").is_none() {
+            return Err(node.error("normalmap needs a <texture name=\"normalmap\">"));
+        }
+        BsdfDesc::NormalMap {
+            map: ctx.texture(node, "normalmap", Vec3::Z)?,
+            inner: Box::new(inner(ctx, one)?),
         }
     };
     ctx.check_unused(node)?;

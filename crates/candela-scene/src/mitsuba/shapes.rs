@@ -151,6 +151,12 @@ fn shape_desc(ctx: &mut Ctx, node: &Node) -> Result<Option<ShapeDesc>, LoadError
         }
         g => g,
     };
+    let geometry = match geometry {
+        GeometryDesc::Mesh(m) if normal_mapped(ctx, &material) && m.tangents.is_empty() => {
+            GeometryDesc::Mesh(Arc::new(with_tangents(&m)))
+        }
+        g => g,
+    };
 
     let mut emission = None;
     for e in node.plugins("emitter") {
@@ -264,6 +270,53 @@ pub(crate) fn vertex_normals(mesh: &MeshDesc) -> Vec<Vec3> {
         *n = n.try_normalize().unwrap_or(Vec3::X);
     }
     normals
+}
+
+/// Whether the named material bends its normals by a map.
+fn normal_mapped(ctx: &Ctx, material: &str) -> bool {
+    fn bsdf(b: &BsdfDesc) -> bool {
+        match b {
+            BsdfDesc::NormalMap { .. } => true,
+            BsdfDesc::TwoSided(inner) | BsdfDesc::OneSided(inner) => bsdf(inner),
+            BsdfDesc::Alpha { inner, .. } => bsdf(inner),
+            _ => false,
+        }
+    }
+    ctx.desc
+        .materials
+        .iter()
+        .find(|m| m.name == material)
+        .is_some_and(|m| bsdf(&m.bsdf))
+}
+
+/// The mesh with per-vertex tangents ∂p/∂u (the sum over its faces, normalized) and
+/// handedness +1. Mitsuba's `normalmap` takes its bitangent as n × ∂p/∂u whatever the
+/// uvs' orientation, where Candela without tangents flips it on mirrored uvs (glTF's
+/// rule), which an OBJ's flipped v makes every face.
+fn with_tangents(mesh: &MeshDesc) -> MeshDesc {
+    let mut tangents = vec![Vec3::ZERO; mesh.positions.len()];
+    if mesh.uvs.len() == mesh.positions.len() {
+        for &[i0, i1, i2] in &mesh.indices {
+            let [p0, p1, p2] = [i0, i1, i2].map(|i| mesh.positions[i as usize]);
+            let [t0, t1, t2] = [i0, i1, i2].map(|i| mesh.uvs[i as usize]);
+            let (d1, d2) = (t1 - t0, t2 - t0);
+            let det = d1.x * d2.y - d1.y * d2.x;
+            if det == 0.0 || !det.is_finite() {
+                continue;
+            }
+            let dpdu = ((p1 - p0) * d2.y - (p2 - p0) * d1.y) / det;
+            for i in [i0, i1, i2] {
+                tangents[i as usize] += dpdu;
+            }
+        }
+    }
+    MeshDesc {
+        tangents: tangents
+            .into_iter()
+            .map(|t| t.try_normalize().unwrap_or(Vec3::ZERO).extend(1.0))
+            .collect(),
+        ..mesh.clone()
+    }
 }
 
 /// Rings from pole to pole and segments around the axis of [`uv_sphere`]: the flat
