@@ -506,6 +506,64 @@ fn meshes_without_normals_are_smoothed_as_mitsuba_does() {
 }
 
 #[test]
+fn cylinders_are_open_tubes_with_mitsubas_frame_and_uvs() {
+    // Mitsuba 3.9.1, for the tube from (1,2,3) to (1,2,5) of radius 0.5:
+    //   s.bbox() = [0.5, 1.5, 3]..[1.5, 2.5, 5], s.surface_area() = 2π
+    // and for the default cylinder, hits at (1,0,0.25), (0,1,0.5), (-1,0,0.75) have uv
+    // (0, 0.25), (0.25, 0.5), (0.5, 0.75) and the normal pointing outwards:
+    //   sc.ray_intersect(mi.Ray3f([2,0,0.25], [-1,0,0])).uv
+    let desc = load(&scene(
+        r#"<shape type="cylinder"><point name="p0" x="1" y="2" z="3"/>
+             <point name="p1" x="1" y="2" z="5"/><float name="radius" value="0.5"/></shape>
+           <shape type="cylinder"/>"#,
+    ));
+    let mesh = |i: usize| match &desc.shapes[i].geometry {
+        GeometryDesc::Mesh(m) => m.clone(),
+        g => panic!("{g:?}"),
+    };
+    let tube = mesh(0);
+    let (lo, hi) = bbox(tube.positions.iter().copied());
+    assert_close(lo, Vec3::new(0.5, 1.5, 3.0), 1e-5);
+    assert_close(hi, Vec3::new(1.5, 2.5, 5.0), 1e-5);
+    let area: f32 = tube
+        .indices
+        .iter()
+        .map(|&[a, b, c]| {
+            let p = |i: u32| tube.positions[i as usize];
+            0.5 * (p(b) - p(a)).cross(p(c) - p(a)).length()
+        })
+        .sum();
+    assert!((area / std::f32::consts::TAU - 1.0).abs() < 2e-4, "{area}");
+    // Faces wind counter-clockwise seen from outside, as the normals point.
+    for &[a, b, c] in &tube.indices {
+        let p = |i: u32| tube.positions[i as usize];
+        let n = (p(b) - p(a)).cross(p(c) - p(a));
+        assert!(n.dot(tube.normals[a as usize]) > 0.0);
+    }
+    let unit = mesh(1);
+    for (p, uv) in [
+        (Vec3::new(1.0, 0.0, 0.0), Vec2::new(0.0, 0.0)),
+        (Vec3::new(0.0, 1.0, 1.0), Vec2::new(0.25, 1.0)),
+        (Vec3::new(-1.0, 0.0, 1.0), Vec2::new(0.5, 1.0)),
+    ] {
+        let i = unit
+            .positions
+            .iter()
+            .position(|q| (*q - p).length() < 1e-5)
+            .unwrap_or_else(|| panic!("no vertex at {p}"));
+        assert!((unit.uvs[i] - uv).length() < 1e-5, "{p}: {}", unit.uvs[i]);
+        assert_close(unit.normals[i], Vec3::new(p.x, p.y, 0.0), 1e-5);
+    }
+    let e = load_err(&scene(
+        r#"<shape type="cylinder"><float name="radius" value="0"/></shape>"#,
+    ));
+    assert!(
+        e.contains("scene.xml:2:1:") && e.contains("positive radius"),
+        "{e}"
+    );
+}
+
+#[test]
 fn meshes_load_with_face_normals_and_flipped_uvs() {
     let obj =
         "v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0.25\nvt 1 0\nvt 0 1\nvn 0 0 1\nf 1/1/1 2/2/1 3/3/1\n";

@@ -6,6 +6,7 @@
 use std::sync::Arc;
 
 use candela_core::desc::{BsdfDesc, GeometryDesc, MeshDesc, ShapeDesc, TextureDesc};
+use candela_core::math::Frame;
 use glam::{Mat4, Vec2, Vec3};
 
 use super::parse::Node;
@@ -102,6 +103,7 @@ fn shape_desc(ctx: &mut Ctx, node: &Node) -> Result<Option<ShapeDesc>, LoadError
             center: node.point("center")?.unwrap_or(Vec3::ZERO),
             radius: node.float("radius")?.unwrap_or(1.0),
         },
+        "cylinder" => GeometryDesc::Mesh(Arc::new(cylinder(node)?)),
         "obj" | "ply" => {
             let file = node
                 .string("filename")?
@@ -317,6 +319,44 @@ fn with_tangents(mesh: &MeshDesc) -> MeshDesc {
             .collect(),
         ..mesh.clone()
     }
+}
+
+/// Segments around a `cylinder`: the flat sides lie within r·(1 − cos(π/128)) ≈ 3·10⁻⁴ r
+/// of the tube and its area is short by 10⁻⁴.
+const CYLINDER_SEGMENTS: u32 = 128;
+
+/// Mitsuba's `cylinder`: an open tube (no caps) of `radius` (1) from `p0` (origin) to `p1`
+/// (0, 0, 1), normals outwards, as a smooth-shaded mesh in the shape's object space (its
+/// `to_world` then applies). Mitsuba's tube is the unit one, z in [0, 1], placed by the
+/// frame of p1 − p0 (`coordinate_system`, i.e. [`Frame::from_z`]); its uv is
+/// (atan2(y, x)/2π, z) in that unit frame.
+fn cylinder(node: &Node) -> Result<MeshDesc, LoadError> {
+    let p0 = node.point("p0")?.unwrap_or(Vec3::ZERO);
+    let p1 = node.point("p1")?.unwrap_or(Vec3::Z);
+    let radius = node.float("radius")?.unwrap_or(1.0);
+    let axis = p1 - p0;
+    if axis.length_squared() == 0.0 || radius <= 0.0 {
+        return Err(node.error("a cylinder needs p0 ≠ p1 and a positive radius"));
+    }
+    let f = Frame::from_z(axis.normalize());
+    let mut mesh = MeshDesc::default();
+    for j in 0..=CYLINDER_SEGMENTS {
+        let u = j as f32 / CYLINDER_SEGMENTS as f32;
+        let (sin, cos) = (u * std::f32::consts::TAU).sin_cos();
+        let radial = f.s * cos + f.t * sin;
+        for v in [0.0, 1.0] {
+            mesh.positions.push(p0 + radial * radius + axis * v);
+            mesh.normals.push(radial);
+            mesh.uvs.push(Vec2::new(u, v));
+        }
+    }
+    for j in 0..CYLINDER_SEGMENTS {
+        let (a, b, c, d) = (2 * j, 2 * j + 2, 2 * j + 3, 2 * j + 1);
+        // Counter-clockwise seen from outside: (s, t, z) is right-handed.
+        mesh.indices.push([a, b, c]);
+        mesh.indices.push([a, c, d]);
+    }
+    Ok(mesh)
 }
 
 /// Rings from pole to pole and segments around the axis of [`uv_sphere`]: the flat
