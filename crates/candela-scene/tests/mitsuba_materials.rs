@@ -247,7 +247,8 @@ fn plastics_become_candelas_plastic_with_warnings_on_what_differs() {
     let loaded = load(
         r#"<shape type="cube"><bsdf type="roughplastic">
            <rgb name="diffuse_reflectance" value="0.1, 0.2, 0.3"/>
-           <float name="int_ior" value="1.6"/><float name="alpha" value="0.3"/></bsdf></shape>"#,
+           <float name="int_ior" value="1.6"/><float name="alpha" value="0.3"/>
+           <boolean name="nonlinear" value="true"/></bsdf></shape>"#,
     );
     match &loaded.desc.materials[0].bsdf {
         BsdfDesc::OneSided(inner) => match inner.as_ref() {
@@ -255,6 +256,7 @@ fn plastics_become_candelas_plastic_with_warnings_on_what_differs() {
                 albedo: TextureDesc::Constant(c),
                 eta,
             } => {
+                // nonlinear=true is Candela's own model: the albedo carries over.
                 assert_eq!(*c, Vec3::new(0.1, 0.2, 0.3));
                 assert!((eta - 1.6 / 1.000277).abs() < 1e-6);
             }
@@ -267,6 +269,45 @@ fn plastics_become_candelas_plastic_with_warnings_on_what_differs() {
         w.contains("smooth coat") && w.contains("scene.xml:2:"),
         "{w}"
     );
+}
+
+#[test]
+fn a_linear_plastic_evaluates_to_mitsubas_diffuse_term() {
+    use candela_core::bsdf::fresnel::{fresnel_dielectric, fresnel_diffuse_reflectance};
+    use candela_core::bsdf::Plastic;
+    // Mitsuba's default plastic (nonlinear=false), its plastic.cpp:
+    //   f_d = ρ (1 − F(θi)) (1 − F(θo)) / (π η² (1 − F_dr)),
+    // F_dr the coat's internal diffuse reflectance. Candela's plastic, with the albedo the
+    // importer gives it, must evaluate to the same, and a smooth plastic warns of nothing.
+    let loaded = load(
+        r#"<shape type="cube"><bsdf type="plastic">
+           <rgb name="diffuse_reflectance" value="0.7, 0.2, 0.05"/>
+           <float name="int_ior" value="1.5"/><float name="ext_ior" value="1"/></bsdf></shape>"#,
+    );
+    assert!(loaded.warnings.is_empty(), "{:?}", loaded.warnings);
+    let albedo = match &loaded.desc.materials[0].bsdf {
+        BsdfDesc::OneSided(inner) => match inner.as_ref() {
+            BsdfDesc::Plastic {
+                albedo: TextureDesc::Constant(c),
+                ..
+            } => *c,
+            other => panic!("{other:?}"),
+        },
+        other => panic!("{other:?}"),
+    };
+    let rho = Vec3::new(0.7, 0.2, 0.05);
+    let eta = 1.5f32;
+    let fdr = fresnel_diffuse_reflectance(1.0 / eta);
+    let plastic = Plastic::new(albedo, eta);
+    for (wo, wi) in [
+        (Vec3::Z, Vec3::new(0.6, 0.0, 0.8)),
+        (Vec3::new(0.0, 0.8, 0.6), Vec3::new(-0.28, 0.0, 0.96)),
+    ] {
+        let (fo, fi) = (fresnel_dielectric(wo.z, eta), fresnel_dielectric(wi.z, eta));
+        let mitsuba =
+            rho * (1.0 - fi) * (1.0 - fo) / (std::f32::consts::PI * eta * eta * (1.0 - fdr));
+        assert_close(plastic.f(wo, wi), mitsuba, 1e-6);
+    }
 }
 
 /// A 2 × 2 8-bit RGB PNG: top row red, green; bottom row blue, white, each channel at 128.
