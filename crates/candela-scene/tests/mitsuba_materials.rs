@@ -79,10 +79,12 @@ fn conductors_take_presets_or_eta_and_k_and_are_one_sided() {
         BsdfDesc::Conductor {
             eta,
             k,
+            specular,
             alpha_u,
             alpha_v,
             distribution,
         } => {
+            assert_eq!(specular, Vec3::ONE);
             assert_eq!(eta, Vec3::new(0.2, 0.9, 1.1));
             assert_eq!(k, Vec3::new(3.9, 2.4, 1.6));
             assert_eq!((alpha_u, alpha_v), (0.05, 0.3));
@@ -180,12 +182,47 @@ fn conductors_take_presets_or_eta_and_k_and_are_one_sided() {
             "phong",
         ),
         (
-            r#"<bsdf type="conductor"><rgb name="specular_reflectance" value="0.5"/></bsdf>"#,
-            "specular_reflectance",
+            r#"<bsdf type="conductor"><texture type="checkerboard" name="specular_reflectance"/></bsdf>"#,
+            "\"specular_reflectance\" other than 1 is not supported",
         ),
     ] {
         let e = load_err(&format!("<shape type=\"cube\">{body}</shape>"));
         assert!(e.contains(what), "{e}");
+    }
+}
+
+#[test]
+fn a_conductors_specular_reflectance_scales_its_fresnel_term() {
+    // Mitsuba's conductor.cpp and roughconductor.cpp multiply the Fresnel term by
+    // specular_reflectance. The importer carries the colour over, and the built lobe is
+    // the plain conductor's times it, for every direction (a closed form: same D, G).
+    let (eta, k) = candela_core::bsdf::metal_preset("Cu").unwrap();
+    let scale = Vec3::new(0.5, 0.7, 0.9);
+    let body = r#"<bsdf type="twosided"><bsdf type="roughconductor"><string name="material" value="Cu"/>
+        <rgb name="specular_reflectance" value="0.5, 0.7, 0.9"/><float name="alpha" value="0.3"/></bsdf></bsdf>"#;
+    let d = bsdf(body);
+    match &d {
+        BsdfDesc::Conductor { specular, .. } => assert_eq!(*specular, scale),
+        other => panic!("{other:?}"),
+    }
+    let scene = build(&load(&format!("<shape type=\"cube\">{body}</shape>")).desc).unwrap();
+    let scaled = match &scene.materials[0] {
+        candela_core::material::Material::Fixed(Lobe::Conductor(c)) => *c,
+        other => panic!("{other:?}"),
+    };
+    assert_eq!(
+        scaled.fresnel,
+        candela_core::bsdf::ConductorFresnel::ScaledComplex { eta, k, scale }
+    );
+    let plain = Conductor {
+        fresnel: candela_core::bsdf::ConductorFresnel::Complex { eta, k },
+        ..scaled
+    };
+    for (wo, wi) in [
+        (Vec3::Z, Vec3::new(0.6, 0.0, 0.8)),
+        (Vec3::new(0.0, 0.8, 0.6), Vec3::new(-0.28, 0.0, 0.96)),
+    ] {
+        assert_close(scaled.f(wo, wi), scale * plain.f(wo, wi), 1e-6);
     }
 }
 

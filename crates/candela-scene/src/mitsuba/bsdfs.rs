@@ -98,10 +98,18 @@ fn two_sided(ctx: &mut Ctx, node: &Node) -> Result<BsdfDesc, LoadError> {
         "conductor" | "roughconductor" => {
             let (eta, k) = conductor_ior(ctx, node)?;
             let (alpha_u, alpha_v, distribution) = roughness(node, kind == "roughconductor")?;
-            unit_only(ctx, node, "specular_reflectance")?;
+            // Mitsuba multiplies the Fresnel term by it; a texture there is refused.
+            let specular = match node.prop("specular_reflectance") {
+                Some(p) if p.tag == "texture" => {
+                    unit_only(ctx, node, "specular_reflectance")?;
+                    Vec3::ONE
+                }
+                _ => node.color("specular_reflectance")?.unwrap_or(Vec3::ONE),
+            };
             BsdfDesc::Conductor {
                 eta,
                 k,
+                specular,
                 alpha_u,
                 alpha_v,
                 distribution,
