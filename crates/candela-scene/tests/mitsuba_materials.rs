@@ -270,13 +270,48 @@ fn dielectrics_read_numbers_and_named_indices() {
             "positive",
         ),
         (
-            r#"<bsdf type="dielectric"><rgb name="specular_transmittance" value="0.5"/></bsdf>"#,
-            "specular_transmittance",
+            r#"<bsdf type="dielectric"><rgb name="specular_reflectance" value="0.5"/></bsdf>"#,
+            "specular_reflectance",
         ),
     ] {
         let e = load_err(&format!("<shape type=\"cube\">{body}</shape>"));
         assert!(e.contains(what), "{e}");
     }
+}
+
+#[test]
+fn a_dielectrics_specular_transmittance_is_its_tint() {
+    // Mitsuba's dielectric and roughdielectric multiply every refraction by
+    // specular_transmittance, which is what Candela's tint does (the transmitted lobe
+    // only); thin sheets have no tint, so there it stays refused unless it is 1.
+    let tint = |body: &str| match bsdf(body) {
+        BsdfDesc::Dielectric { tint, .. } => tint,
+        other => panic!("{other:?}"),
+    };
+    match tint(
+        r#"<bsdf type="dielectric"><rgb name="specular_transmittance" value="0.9, 0.5, 0.2"/></bsdf>"#,
+    ) {
+        TextureDesc::Constant(c) => assert_eq!(c, Vec3::new(0.9, 0.5, 0.2)),
+        t => panic!("{t:?}"),
+    }
+    assert!(matches!(
+        tint(
+            r#"<bsdf type="roughdielectric"><texture type="checkerboard" name="specular_transmittance"/></bsdf>"#
+        ),
+        TextureDesc::Checker { .. }
+    ));
+    match tint(r#"<bsdf type="dielectric"/>"#) {
+        TextureDesc::Constant(c) => assert_eq!(c, Vec3::ONE),
+        t => panic!("{t:?}"),
+    }
+    let e = load_err(
+        r#"<shape type="cube"><bsdf type="thindielectric">
+             <rgb name="specular_transmittance" value="0.5"/></bsdf></shape>"#,
+    );
+    assert!(
+        e.contains("scene.xml:3:14:") && e.contains("\"specular_transmittance\" other than 1"),
+        "{e}"
+    );
 }
 
 #[test]

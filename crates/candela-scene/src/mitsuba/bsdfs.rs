@@ -119,14 +119,22 @@ fn two_sided(ctx: &mut Ctx, node: &Node) -> Result<BsdfDesc, LoadError> {
             let eta = ior(node, "int_ior", 1.5046)? / ior(node, "ext_ior", 1.000277)?;
             let (alpha_u, alpha_v, distribution) = roughness(node, kind == "roughdielectric")?;
             unit_only(ctx, node, "specular_reflectance")?;
-            unit_only(ctx, node, "specular_transmittance")?;
+            let thin = kind == "thindielectric";
+            // Mitsuba multiplies each refraction by specular_transmittance, as Candela's
+            // tint does (which thin sheets lack).
+            let tint = if thin {
+                unit_only(ctx, node, "specular_transmittance")?;
+                TextureDesc::Constant(Vec3::ONE)
+            } else {
+                ctx.texture(node, "specular_transmittance", Vec3::ONE)?
+            };
             BsdfDesc::Dielectric {
                 eta,
                 alpha_u,
                 alpha_v,
                 distribution,
-                thin: kind == "thindielectric",
-                tint: TextureDesc::Constant(Vec3::ONE),
+                thin,
+                tint,
             }
         }
         "plastic" | "roughplastic" => {
