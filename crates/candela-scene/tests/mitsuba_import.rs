@@ -368,6 +368,40 @@ fn includes_and_references_resolve() {
 }
 
 #[test]
+fn twosided_and_mask_may_wrap_a_reference() {
+    // Mitsuba 3.9.1 loads <bsdf type="twosided"><ref id="inner"/></bsdf> (and the same in
+    // a mask) as the wrapper around the BSDF defined earlier under that id.
+    let desc = load(&scene(
+        r#"<bsdf type="diffuse" id="inner"><rgb name="reflectance" value="0.2, 0.7, 0.2"/></bsdf>
+           <bsdf type="twosided" id="ts"><ref id="inner"/></bsdf>
+           <bsdf type="mask" id="m"><float name="opacity" value="0.3"/><ref id="inner"/></bsdf>
+           <shape type="cube"><ref id="ts"/></shape>"#,
+    ));
+    let mat = |name: &str| &desc.materials.iter().find(|m| m.name == name).unwrap().bsdf;
+    match mat("ts") {
+        BsdfDesc::Diffuse {
+            albedo: TextureDesc::Constant(c),
+        } => assert_eq!(*c, Vec3::new(0.2, 0.7, 0.2)),
+        b => panic!("{b:?}"),
+    }
+    match mat("m") {
+        BsdfDesc::Alpha { alpha, inner } => {
+            assert_eq!(alpha.factor, 0.3);
+            assert!(matches!(inner.as_ref(), BsdfDesc::OneSided(_)), "{inner:?}");
+        }
+        b => panic!("{b:?}"),
+    }
+    let e = load_err(&scene(
+        r#"<bsdf type="twosided" id="ts"><ref id="later"/></bsdf>
+           <bsdf type="diffuse" id="later"/>"#,
+    ));
+    assert!(
+        e.contains("scene.xml:2:31:") && e.contains("\"later\""),
+        "{e}"
+    );
+}
+
+#[test]
 fn emitters_map_to_area_and_point_lights() {
     let desc = load(&scene(
         r#"<shape type="sphere"><boolean name="flip_normals" value="true"/>

@@ -65,7 +65,11 @@ fn bsdf(ctx: &mut Ctx, node: &Node) -> Result<BsdfDesc, LoadError> {
         let inner: Vec<&Node> = node.plugins("bsdf").collect();
         let d = match inner.as_slice() {
             [one] => two_sided(ctx, one)?,
-            [] => return Err(node.error("twosided needs a nested <bsdf>")),
+            [] => match referenced(ctx, node)? {
+                Some(BsdfDesc::OneSided(d)) => *d,
+                Some(d) => d,
+                None => return Err(node.error("twosided needs a nested <bsdf> or a <ref>")),
+            },
             _ => {
                 ctx.unsupported(
                     node,
@@ -78,7 +82,7 @@ fn bsdf(ctx: &mut Ctx, node: &Node) -> Result<BsdfDesc, LoadError> {
         return Ok(d);
     }
     if matches!(node.kind(), "mask" | "normalmap") {
-        return wrapper(ctx, node, bsdf);
+        return wrapper(ctx, node, false);
     }
     Ok(match two_sided(ctx, node)? {
         d @ (BsdfDesc::Diffuse { .. } | BsdfDesc::Conductor { .. } | BsdfDesc::Plastic { .. }) => {
@@ -158,7 +162,7 @@ fn two_sided(ctx: &mut Ctx, node: &Node) -> Result<BsdfDesc, LoadError> {
             };
             BsdfDesc::Plastic { albedo, eta }
         }
-        "mask" | "normalmap" => return wrapper(ctx, node, two_sided),
+        "mask" | "normalmap" => return wrapper(ctx, node, true),
         "twosided" => return Err(node.error("twosided inside twosided")),
         _ => {
             ctx.unsupported(node, format!("<{}> is not supported", describe(node)))?;
@@ -170,22 +174,36 @@ fn two_sided(ctx: &mut Ctx, node: &Node) -> Result<BsdfDesc, LoadError> {
     Ok(d)
 }
 
-/// `mask` and `normalmap`, which wrap one nested BSDF (mapped by `inner`, so that it
-/// keeps the sidedness of where the wrapper sits).
+/// `mask` and `normalmap`, which wrap one nested BSDF or a `<ref>` to one (two-sided
+/// where the wrapper sits in a `twosided`, so that it keeps the sidedness of its place).
 ///
 /// - `mask`: Mitsuba's opacity α (default 0.5) lets a ray pass with probability 1 − α,
 ///   which is Candela's stochastic alpha ([`AlphaMode::Blend`]); a texture's first
 ///   channel is read.
 /// - `normalmap`: Mitsuba's shading normal 2·rgb − 1 in the frame of ∂p/∂u and n × ∂p/∂u,
 ///   Candela's tangent-space normal map (x along +u, y along +v) on the same uvs.
-fn wrapper(
-    ctx: &mut Ctx,
-    node: &Node,
-    inner: fn(&mut Ctx, &Node) -> Result<BsdfDesc, LoadError>,
-) -> Result<BsdfDesc, LoadError> {
+fn wrapper(ctx: &mut Ctx, node: &Node, in_two_sided: bool) -> Result<BsdfDesc, LoadError> {
     let nested: Vec<&Node> = node.plugins("bsdf").collect();
-    let [one] = nested.as_slice() else {
-        return Err(node.error(format!("{} needs exactly one nested <bsdf>", node.kind())));
+    let inner_desc = match nested.as_slice() {
+        [one] => Some(*one),
+        [] => None,
+        _ => return Err(node.error(format!("{} needs exactly one nested <bsdf>", node.kind()))),
+    };
+    let inner = |ctx: &mut Ctx| -> Result<BsdfDesc, LoadError> {
+        match (inner_desc, in_two_sided) {
+            (Some(one), true) => return two_sided(ctx, one),
+            (Some(one), false) => return bsdf(ctx, one),
+            (None, _) => {}
+        }
+        match referenced(ctx, node)? {
+            // Where the wrapper sits inside a twosided, so does what it refers to.
+            Some(BsdfDesc::OneSided(d)) if in_two_sided => Ok(*d),
+            Some(d) => Ok(d),
+            None => Err(node.error(format!(
+                "{} needs exactly one nested <bsdf> or a <ref>",
+                node.kind()
+            ))),
+        }
     };
     let d = if node.kind() == "mask" {
         let textured = node
@@ -206,7 +224,7 @@ fn wrapper(
         };
         BsdfDesc::Alpha {
             alpha,
-            inner: Box::new(inner(ctx, one)?),
+            inner: Box::new(inner(ctx)?),
         }
     } else {
         if node.prop("normalmap").is_none() {
@@ -214,7 +232,7 @@ fn wrapper(
         }
         BsdfDesc::NormalMap {
             map: ctx.texture(node, "normalmap", Vec3::Z)?,
-            inner: Box::new(inner(ctx, one)?),
+            inner: Box::new(inner(ctx)?),
         }
     };
     ctx.check_unused(node)?;
@@ -247,6 +265,32 @@ fn linear_plastic_albedo(albedo: TextureDesc, fdr: f32) -> TextureDesc {
                 ..t
             })
         }
+    }
+}
+
+/// The BSDF a wrapper's single `<ref id>` (one not naming a texture slot) refers to, as
+/// it was mapped where it is defined (one-sided unless it is a twosided); `None` without
+/// such a ref.
+fn referenced(ctx: &mut Ctx, node: &Node) -> Result<Option<BsdfDesc>, LoadError> {
+    let Some(r) = node
+        .children
+        .iter()
+        .find(|c| c.tag == "ref" && matches!(c.name(), "" | "bsdf"))
+    else {
+        return Ok(None);
+    };
+    r.used.set(true);
+    let id = r.req("id")?;
+    let found = ctx.bsdf_ids.get(id).and_then(|name| {
+        ctx.desc
+            .materials
+            .iter()
+            .find(|m| &m.name == name)
+            .map(|m| m.bsdf.clone())
+    });
+    match found {
+        Some(d) => Ok(Some(d)),
+        None => Err(r.error(format!("no <bsdf> defined before it has the id \"{id}\""))),
     }
 }
 
