@@ -567,15 +567,26 @@ fn build_material(bsdf: &BsdfDesc, span: &Span) -> Result<Material, BuildError> 
         BsdfDesc::Conductor {
             eta,
             k,
+            specular,
             alpha_u,
             alpha_v,
             distribution,
         } => {
             check_color(span, "eta", *eta)?;
             check_color(span, "k", *k)?;
+            check_color(span, "specular", *specular)?;
+            let (eta, k) = (*eta, *k);
             Material::Fixed(Lobe::Conductor(Conductor {
                 distrib: microfacet(span, *alpha_u, *alpha_v, *distribution)?,
-                fresnel: ConductorFresnel::Complex { eta: *eta, k: *k },
+                fresnel: if *specular == Vec3::ONE {
+                    ConductorFresnel::Complex { eta, k }
+                } else {
+                    ConductorFresnel::ScaledComplex {
+                        eta,
+                        k,
+                        scale: *specular,
+                    }
+                },
             }))
         }
         BsdfDesc::Dielectric {

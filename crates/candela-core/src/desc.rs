@@ -165,6 +165,9 @@ pub enum BsdfDesc {
     Conductor {
         eta: Vec3,
         k: Vec3,
+        /// Multiplies the Fresnel reflectance (Mitsuba's `specular_reflectance`); one for
+        /// a plain metal.
+        specular: Vec3,
         alpha_u: f32,
         alpha_v: f32,
         distribution: MicrofacetDesc,

@@ -232,6 +232,7 @@ pub(crate) fn parse_material(
             BsdfDesc::Conductor {
                 eta,
                 k,
+                specular: Vec3::ONE,
                 alpha_u,
                 alpha_v,
                 distribution,

@@ -79,10 +79,12 @@ fn conductors_take_presets_or_eta_and_k_and_are_one_sided() {
         BsdfDesc::Conductor {
             eta,
             k,
+            specular,
             alpha_u,
             alpha_v,
             distribution,
         } => {
+            assert_eq!(specular, Vec3::ONE);
             assert_eq!(eta, Vec3::new(0.2, 0.9, 1.1));
             assert_eq!(k, Vec3::new(3.9, 2.4, 1.6));
             assert_eq!((alpha_u, alpha_v), (0.05, 0.3));
@@ -180,12 +182,47 @@ fn conductors_take_presets_or_eta_and_k_and_are_one_sided() {
             "phong",
         ),
         (
-            r#"<bsdf type="conductor"><rgb name="specular_reflectance" value="0.5"/></bsdf>"#,
-            "specular_reflectance",
+            r#"<bsdf type="conductor"><texture type="checkerboard" name="specular_reflectance"/></bsdf>"#,
+            "\"specular_reflectance\" other than 1 is not supported",
         ),
     ] {
         let e = load_err(&format!("<shape type=\"cube\">{body}</shape>"));
         assert!(e.contains(what), "{e}");
+    }
+}
+
+#[test]
+fn a_conductors_specular_reflectance_scales_its_fresnel_term() {
+    // Mitsuba's conductor.cpp and roughconductor.cpp multiply the Fresnel term by
+    // specular_reflectance. The importer carries the colour over, and the built lobe is
+    // the plain conductor's times it, for every direction (a closed form: same D, G).
+    let (eta, k) = candela_core::bsdf::metal_preset("Cu").unwrap();
+    let scale = Vec3::new(0.5, 0.7, 0.9);
+    let body = r#"<bsdf type="twosided"><bsdf type="roughconductor"><string name="material" value="Cu"/>
+        <rgb name="specular_reflectance" value="0.5, 0.7, 0.9"/><float name="alpha" value="0.3"/></bsdf></bsdf>"#;
+    let d = bsdf(body);
+    match &d {
+        BsdfDesc::Conductor { specular, .. } => assert_eq!(*specular, scale),
+        other => panic!("{other:?}"),
+    }
+    let scene = build(&load(&format!("<shape type=\"cube\">{body}</shape>")).desc).unwrap();
+    let scaled = match &scene.materials[0] {
+        candela_core::material::Material::Fixed(Lobe::Conductor(c)) => *c,
+        other => panic!("{other:?}"),
+    };
+    assert_eq!(
+        scaled.fresnel,
+        candela_core::bsdf::ConductorFresnel::ScaledComplex { eta, k, scale }
+    );
+    let plain = Conductor {
+        fresnel: candela_core::bsdf::ConductorFresnel::Complex { eta, k },
+        ..scaled
+    };
+    for (wo, wi) in [
+        (Vec3::Z, Vec3::new(0.6, 0.0, 0.8)),
+        (Vec3::new(0.0, 0.8, 0.6), Vec3::new(-0.28, 0.0, 0.96)),
+    ] {
+        assert_close(scaled.f(wo, wi), scale * plain.f(wo, wi), 1e-6);
     }
 }
 
@@ -233,8 +270,8 @@ fn dielectrics_read_numbers_and_named_indices() {
             "positive",
         ),
         (
-            r#"<bsdf type="dielectric"><rgb name="specular_transmittance" value="0.5"/></bsdf>"#,
-            "specular_transmittance",
+            r#"<bsdf type="dielectric"><rgb name="specular_reflectance" value="0.5"/></bsdf>"#,
+            "specular_reflectance",
         ),
     ] {
         let e = load_err(&format!("<shape type=\"cube\">{body}</shape>"));
@@ -243,11 +280,47 @@ fn dielectrics_read_numbers_and_named_indices() {
 }
 
 #[test]
+fn a_dielectrics_specular_transmittance_is_its_tint() {
+    // Mitsuba's dielectric and roughdielectric multiply every refraction by
+    // specular_transmittance, which is what Candela's tint does (the transmitted lobe
+    // only); thin sheets have no tint, so there it stays refused unless it is 1.
+    let tint = |body: &str| match bsdf(body) {
+        BsdfDesc::Dielectric { tint, .. } => tint,
+        other => panic!("{other:?}"),
+    };
+    match tint(
+        r#"<bsdf type="dielectric"><rgb name="specular_transmittance" value="0.9, 0.5, 0.2"/></bsdf>"#,
+    ) {
+        TextureDesc::Constant(c) => assert_eq!(c, Vec3::new(0.9, 0.5, 0.2)),
+        t => panic!("{t:?}"),
+    }
+    assert!(matches!(
+        tint(
+            r#"<bsdf type="roughdielectric"><texture type="checkerboard" name="specular_transmittance"/></bsdf>"#
+        ),
+        TextureDesc::Checker { .. }
+    ));
+    match tint(r#"<bsdf type="dielectric"/>"#) {
+        TextureDesc::Constant(c) => assert_eq!(c, Vec3::ONE),
+        t => panic!("{t:?}"),
+    }
+    let e = load_err(
+        r#"<shape type="cube"><bsdf type="thindielectric">
+             <rgb name="specular_transmittance" value="0.5"/></bsdf></shape>"#,
+    );
+    assert!(
+        e.contains("scene.xml:3:14:") && e.contains("\"specular_transmittance\" other than 1"),
+        "{e}"
+    );
+}
+
+#[test]
 fn plastics_become_candelas_plastic_with_warnings_on_what_differs() {
     let loaded = load(
         r#"<shape type="cube"><bsdf type="roughplastic">
            <rgb name="diffuse_reflectance" value="0.1, 0.2, 0.3"/>
-           <float name="int_ior" value="1.6"/><float name="alpha" value="0.3"/></bsdf></shape>"#,
+           <float name="int_ior" value="1.6"/><float name="alpha" value="0.3"/>
+           <boolean name="nonlinear" value="true"/></bsdf></shape>"#,
     );
     match &loaded.desc.materials[0].bsdf {
         BsdfDesc::OneSided(inner) => match inner.as_ref() {
@@ -255,6 +328,7 @@ fn plastics_become_candelas_plastic_with_warnings_on_what_differs() {
                 albedo: TextureDesc::Constant(c),
                 eta,
             } => {
+                // nonlinear=true is Candela's own model: the albedo carries over.
                 assert_eq!(*c, Vec3::new(0.1, 0.2, 0.3));
                 assert!((eta - 1.6 / 1.000277).abs() < 1e-6);
             }
@@ -267,6 +341,45 @@ fn plastics_become_candelas_plastic_with_warnings_on_what_differs() {
         w.contains("smooth coat") && w.contains("scene.xml:2:"),
         "{w}"
     );
+}
+
+#[test]
+fn a_linear_plastic_evaluates_to_mitsubas_diffuse_term() {
+    use candela_core::bsdf::fresnel::{fresnel_dielectric, fresnel_diffuse_reflectance};
+    use candela_core::bsdf::Plastic;
+    // Mitsuba's default plastic (nonlinear=false), its plastic.cpp:
+    //   f_d = ρ (1 − F(θi)) (1 − F(θo)) / (π η² (1 − F_dr)),
+    // F_dr the coat's internal diffuse reflectance. Candela's plastic, with the albedo the
+    // importer gives it, must evaluate to the same, and a smooth plastic warns of nothing.
+    let loaded = load(
+        r#"<shape type="cube"><bsdf type="plastic">
+           <rgb name="diffuse_reflectance" value="0.7, 0.2, 0.05"/>
+           <float name="int_ior" value="1.5"/><float name="ext_ior" value="1"/></bsdf></shape>"#,
+    );
+    assert!(loaded.warnings.is_empty(), "{:?}", loaded.warnings);
+    let albedo = match &loaded.desc.materials[0].bsdf {
+        BsdfDesc::OneSided(inner) => match inner.as_ref() {
+            BsdfDesc::Plastic {
+                albedo: TextureDesc::Constant(c),
+                ..
+            } => *c,
+            other => panic!("{other:?}"),
+        },
+        other => panic!("{other:?}"),
+    };
+    let rho = Vec3::new(0.7, 0.2, 0.05);
+    let eta = 1.5f32;
+    let fdr = fresnel_diffuse_reflectance(1.0 / eta);
+    let plastic = Plastic::new(albedo, eta);
+    for (wo, wi) in [
+        (Vec3::Z, Vec3::new(0.6, 0.0, 0.8)),
+        (Vec3::new(0.0, 0.8, 0.6), Vec3::new(-0.28, 0.0, 0.96)),
+    ] {
+        let (fo, fi) = (fresnel_dielectric(wo.z, eta), fresnel_dielectric(wi.z, eta));
+        let mitsuba =
+            rho * (1.0 - fi) * (1.0 - fo) / (std::f32::consts::PI * eta * eta * (1.0 - fdr));
+        assert_close(plastic.f(wo, wi), mitsuba, 1e-6);
+    }
 }
 
 /// A 2 × 2 8-bit RGB PNG: top row red, green; bottom row blue, white, each channel at 128.
@@ -584,6 +697,83 @@ fn constant_emitters_and_hidden_emitters() {
         assert_close(px(8, 8), Vec3::splat(centre), 1e-4);
         assert_close(px(0, 0), Vec3::splat(corner), 1e-4);
     }
+}
+
+#[test]
+fn masks_become_stochastic_alpha_and_normalmaps_get_mitsubas_bitangent() {
+    use candela_core::alpha::AlphaMode;
+    // Mitsuba's `mask` keeps a hit with probability α (default 0.5) around the nested
+    // BSDF, whose sidedness it keeps.
+    let alpha = |b: &BsdfDesc| match b {
+        BsdfDesc::Alpha { alpha, inner } => (alpha.clone(), inner.as_ref().clone()),
+        b => panic!("{b:?}"),
+    };
+    let (a, inner) = alpha(&bsdf(
+        r#"<bsdf type="mask"><float name="opacity" value="0.4"/><bsdf type="diffuse"/></bsdf>"#,
+    ));
+    assert_eq!(
+        (a.mode, a.factor, a.texture.is_none()),
+        (AlphaMode::Blend, 0.4, true)
+    );
+    assert!(matches!(inner, BsdfDesc::OneSided(_)), "{inner:?}");
+    let (a, inner) = alpha(&bsdf(
+        r#"<bsdf type="mask"><bsdf type="twosided"><bsdf type="diffuse"/></bsdf></bsdf>"#,
+    ));
+    assert_eq!(a.factor, 0.5);
+    assert!(matches!(inner, BsdfDesc::Diffuse { .. }), "{inner:?}");
+    let (a, _) = alpha(&bsdf(
+        r#"<bsdf type="mask"><texture type="checkerboard" name="opacity"/><bsdf type="diffuse"/></bsdf>"#,
+    ));
+    assert!(matches!(a.texture, Some(TextureDesc::Checker { .. })) && a.factor == 1.0);
+    let e = load_err(r#"<shape type="cube"><bsdf type="mask"/></shape>"#);
+    assert!(
+        e.contains("scene.xml:2:20:") && e.contains("one nested <bsdf>"),
+        "{e}"
+    );
+
+    // A normal map on an OBJ: Mitsuba's bitangent is n × ∂p/∂u, so the importer gives
+    // the mesh tangents ∂p/∂u with handedness +1 (the OBJ's flipped v would otherwise
+    // flip Candela's bitangent).
+    let obj = "v -1 -1 0\nv 1 -1 0\nv 1 1 0\nv -1 1 0\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\n\
+               f 1/1 2/2 3/3\nf 1/1 3/3 4/4\n";
+    let xml = scene(
+        r#"<shape type="obj"><string name="filename" value="quad.obj"/>
+             <bsdf type="normalmap"><texture type="checkerboard" name="normalmap"/>
+               <bsdf type="diffuse"/></bsdf></shape>
+           <shape type="obj"><string name="filename" value="quad.obj"/></shape>"#,
+    );
+    let desc = load_files(
+        &[("scene.xml", xml.as_bytes()), ("quad.obj", obj.as_bytes())],
+        false,
+    )
+    .unwrap()
+    .desc;
+    match &desc.materials[0].bsdf {
+        BsdfDesc::NormalMap { map, inner } => {
+            assert!(matches!(map, TextureDesc::Checker { .. }));
+            assert!(matches!(inner.as_ref(), BsdfDesc::OneSided(_)), "{inner:?}");
+        }
+        b => panic!("{b:?}"),
+    }
+    let mesh = |i: usize| match &desc.shapes[i].geometry {
+        GeometryDesc::Mesh(m) => m.clone(),
+        g => panic!("{g:?}"),
+    };
+    assert_eq!(
+        mesh(0).tangents,
+        vec![glam::Vec4::new(1.0, 0.0, 0.0, 1.0); 4]
+    );
+    assert!(
+        mesh(1).tangents.is_empty(),
+        "only normal-mapped meshes get tangents"
+    );
+    let e = load_err(
+        r#"<shape type="cube"><bsdf type="normalmap"><bsdf type="diffuse"/></bsdf></shape>"#,
+    );
+    assert!(
+        e.contains("scene.xml:2:20:") && e.contains("normalmap needs"),
+        "{e}"
+    );
 }
 
 #[test]

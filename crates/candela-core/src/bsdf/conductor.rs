@@ -15,6 +15,9 @@ pub enum ConductorFresnel {
     /// Schlick's approximation from the normal-incidence reflectance F₀ (glTF metals;
     /// F₀ = 1 gives the ideal white conductor of the furnace test).
     Schlick { f0: Vec3 },
+    /// [`ConductorFresnel::Complex`] times a colour (Mitsuba's `specular_reflectance`, a
+    /// factor its conductors apply to the Fresnel term).
+    ScaledComplex { eta: Vec3, k: Vec3, scale: Vec3 },
 }
 
 impl ConductorFresnel {
@@ -22,6 +25,9 @@ impl ConductorFresnel {
         match *self {
             ConductorFresnel::Complex { eta, k } => fresnel_conductor(cos_i, eta, k),
             ConductorFresnel::Schlick { f0 } => fresnel_schlick(f0, cos_i),
+            ConductorFresnel::ScaledComplex { eta, k, scale } => {
+                scale * fresnel_conductor(cos_i, eta, k)
+            }
         }
     }
 }

@@ -2,8 +2,14 @@
 //! one-sided (black from the back) unless wrapped in `twosided`; Candela's are two-sided,
 //! so an unwrapped one becomes [`BsdfDesc::OneSided`]. Dielectrics are two-sided in both.
 
+use candela_core::alpha::AlphaMode;
+use std::sync::Arc;
+
+use candela_core::bsdf::fresnel::fresnel_diffuse_reflectance;
 use candela_core::bsdf::metal_preset;
-use candela_core::desc::{BsdfDesc, MaterialDesc, MicrofacetDesc, TextureDesc};
+use candela_core::desc::{
+    AlphaDesc, BsdfDesc, ImageDesc, ImageTextureDesc, MaterialDesc, MicrofacetDesc, TextureDesc,
+};
 use glam::Vec3;
 
 use super::parse::Node;
@@ -59,7 +65,11 @@ fn bsdf(ctx: &mut Ctx, node: &Node) -> Result<BsdfDesc, LoadError> {
         let inner: Vec<&Node> = node.plugins("bsdf").collect();
         let d = match inner.as_slice() {
             [one] => two_sided(ctx, one)?,
-            [] => return Err(node.error("twosided needs a nested <bsdf>")),
+            [] => match referenced(ctx, node)? {
+                Some(BsdfDesc::OneSided(d)) => *d,
+                Some(d) => d,
+                None => return Err(node.error("twosided needs a nested <bsdf> or a <ref>")),
+            },
             _ => {
                 ctx.unsupported(
                     node,
@@ -70,6 +80,9 @@ fn bsdf(ctx: &mut Ctx, node: &Node) -> Result<BsdfDesc, LoadError> {
         };
         ctx.check_unused(node)?;
         return Ok(d);
+    }
+    if matches!(node.kind(), "mask" | "normalmap") {
+        return wrapper(ctx, node, false);
     }
     Ok(match two_sided(ctx, node)? {
         d @ (BsdfDesc::Diffuse { .. } | BsdfDesc::Conductor { .. } | BsdfDesc::Plastic { .. }) => {
@@ -89,10 +102,18 @@ fn two_sided(ctx: &mut Ctx, node: &Node) -> Result<BsdfDesc, LoadError> {
         "conductor" | "roughconductor" => {
             let (eta, k) = conductor_ior(ctx, node)?;
             let (alpha_u, alpha_v, distribution) = roughness(node, kind == "roughconductor")?;
-            unit_only(ctx, node, "specular_reflectance")?;
+            // Mitsuba multiplies the Fresnel term by it; a texture there is refused.
+            let specular = match node.prop("specular_reflectance") {
+                Some(p) if p.tag == "texture" => {
+                    unit_only(ctx, node, "specular_reflectance")?;
+                    Vec3::ONE
+                }
+                _ => node.color("specular_reflectance")?.unwrap_or(Vec3::ONE),
+            };
             BsdfDesc::Conductor {
                 eta,
                 k,
+                specular,
                 alpha_u,
                 alpha_v,
                 distribution,
@@ -102,14 +123,22 @@ fn two_sided(ctx: &mut Ctx, node: &Node) -> Result<BsdfDesc, LoadError> {
             let eta = ior(node, "int_ior", 1.5046)? / ior(node, "ext_ior", 1.000277)?;
             let (alpha_u, alpha_v, distribution) = roughness(node, kind == "roughdielectric")?;
             unit_only(ctx, node, "specular_reflectance")?;
-            unit_only(ctx, node, "specular_transmittance")?;
+            let thin = kind == "thindielectric";
+            // Mitsuba multiplies each refraction by specular_transmittance, as Candela's
+            // tint does (which thin sheets lack).
+            let tint = if thin {
+                unit_only(ctx, node, "specular_transmittance")?;
+                TextureDesc::Constant(Vec3::ONE)
+            } else {
+                ctx.texture(node, "specular_transmittance", Vec3::ONE)?
+            };
             BsdfDesc::Dielectric {
                 eta,
                 alpha_u,
                 alpha_v,
                 distribution,
-                thin: kind == "thindielectric",
-                tint: TextureDesc::Constant(Vec3::ONE),
+                thin,
+                tint,
             }
         }
         "plastic" | "roughplastic" => {
@@ -123,22 +152,17 @@ fn two_sided(ctx: &mut Ctx, node: &Node) -> Result<BsdfDesc, LoadError> {
                 );
             }
             unit_only(ctx, node, "specular_reflectance")?;
-            if node.boolean("nonlinear")? == Some(true) {
-                ctx.warn(
-                    node,
-                    "nonlinear=true is ignored: Candela's plastic is linear",
-                );
-            }
-            ctx.warn(
-                node,
-                "plastic: Candela's coat model (albedo 1 at reflectance 1) differs from \
-                 Mitsuba's in how much light the coat traps; diffuse tones differ slightly",
-            );
-            BsdfDesc::Plastic {
-                albedo: ctx.texture(node, "diffuse_reflectance", Vec3::splat(0.5))?,
-                eta,
-            }
+            let albedo = ctx.texture(node, "diffuse_reflectance", Vec3::splat(0.5))?;
+            // Candela's plastic is Mitsuba's `nonlinear` one; the default (linear) one
+            // is the same lobe with another albedo.
+            let albedo = if node.boolean("nonlinear")?.unwrap_or(false) {
+                albedo
+            } else {
+                linear_plastic_albedo(albedo, fresnel_diffuse_reflectance(1.0 / eta))
+            };
+            BsdfDesc::Plastic { albedo, eta }
         }
+        "mask" | "normalmap" => return wrapper(ctx, node, true),
         "twosided" => return Err(node.error("twosided inside twosided")),
         _ => {
             ctx.unsupported(node, format!("<{}> is not supported", describe(node)))?;
@@ -148,6 +172,126 @@ fn two_sided(ctx: &mut Ctx, node: &Node) -> Result<BsdfDesc, LoadError> {
     };
     ctx.check_unused(node)?;
     Ok(d)
+}
+
+/// `mask` and `normalmap`, which wrap one nested BSDF or a `<ref>` to one (two-sided
+/// where the wrapper sits in a `twosided`, so that it keeps the sidedness of its place).
+///
+/// - `mask`: Mitsuba's opacity α (default 0.5) lets a ray pass with probability 1 − α,
+///   which is Candela's stochastic alpha ([`AlphaMode::Blend`]); a texture's first
+///   channel is read.
+/// - `normalmap`: Mitsuba's shading normal 2·rgb − 1 in the frame of ∂p/∂u and n × ∂p/∂u,
+///   Candela's tangent-space normal map (x along +u, y along +v) on the same uvs.
+fn wrapper(ctx: &mut Ctx, node: &Node, in_two_sided: bool) -> Result<BsdfDesc, LoadError> {
+    let nested: Vec<&Node> = node.plugins("bsdf").collect();
+    let inner_desc = match nested.as_slice() {
+        [one] => Some(*one),
+        [] => None,
+        _ => return Err(node.error(format!("{} needs exactly one nested <bsdf>", node.kind()))),
+    };
+    let inner = |ctx: &mut Ctx| -> Result<BsdfDesc, LoadError> {
+        match (inner_desc, in_two_sided) {
+            (Some(one), true) => return two_sided(ctx, one),
+            (Some(one), false) => return bsdf(ctx, one),
+            (None, _) => {}
+        }
+        match referenced(ctx, node)? {
+            // Where the wrapper sits inside a twosided, so does what it refers to.
+            Some(BsdfDesc::OneSided(d)) if in_two_sided => Ok(*d),
+            Some(d) => Ok(d),
+            None => Err(node.error(format!(
+                "{} needs exactly one nested <bsdf> or a <ref>",
+                node.kind()
+            ))),
+        }
+    };
+    let d = if node.kind() == "mask" {
+        let textured = node
+            .children
+            .iter()
+            .any(|c| c.name() == "opacity" && matches!(c.tag.as_str(), "texture" | "ref"));
+        let alpha = match textured {
+            true => AlphaDesc {
+                mode: AlphaMode::Blend,
+                factor: 1.0,
+                texture: Some(ctx.texture(node, "opacity", Vec3::ONE)?),
+            },
+            false => AlphaDesc {
+                mode: AlphaMode::Blend,
+                factor: node.float("opacity")?.unwrap_or(0.5),
+                texture: None,
+            },
+        };
+        BsdfDesc::Alpha {
+            alpha,
+            inner: Box::new(inner(ctx)?),
+        }
+    } else {
+        if node.prop("normalmap").is_none() {
+            return Err(node.error("normalmap needs a <texture name=\"normalmap\">"));
+        }
+        BsdfDesc::NormalMap {
+            map: ctx.texture(node, "normalmap", Vec3::Z)?,
+            inner: Box::new(inner(ctx)?),
+        }
+    };
+    ctx.check_unused(node)?;
+    Ok(d)
+}
+
+/// The albedo ρ′ under which Candela's plastic (Mitsuba's `nonlinear` one, whose diffuse
+/// term is ρ/(1 − ρ·F_dr)) equals Mitsuba's default, linear plastic of albedo ρ, whose
+/// term is ρ/(1 − F_dr) (its `plastic.cpp`; F_dr is the coat's internal diffuse Fresnel
+/// reflectance): ρ′/(1 − ρ′F_dr) = ρ/(1 − F_dr) gives ρ′ = ρ/(1 − F_dr + ρF_dr), which
+/// stays ≤ 1 for ρ ≤ 1. Applied per texel to images (bilinear filtering then blends the
+/// mapped texels, a difference of second order) and to each checkerboard colour.
+fn linear_plastic_albedo(albedo: TextureDesc, fdr: f32) -> TextureDesc {
+    let map = |rho: Vec3| rho / (Vec3::splat(1.0 - fdr) + rho * fdr);
+    match albedo {
+        TextureDesc::Constant(c) => TextureDesc::Constant(map(c)),
+        TextureDesc::Checker { a, b, uv_transform } => TextureDesc::Checker {
+            a: map(a),
+            b: map(b),
+            uv_transform,
+        },
+        TextureDesc::Image(t) => {
+            let pixels = t.image.pixels.iter().map(|&p| map(p * t.scale)).collect();
+            TextureDesc::Image(ImageTextureDesc {
+                image: Arc::new(ImageDesc {
+                    pixels,
+                    ..ImageDesc::clone(&t.image)
+                }),
+                scale: Vec3::ONE,
+                ..t
+            })
+        }
+    }
+}
+
+/// The BSDF a wrapper's single `<ref id>` (one not naming a texture slot) refers to, as
+/// it was mapped where it is defined (one-sided unless it is a twosided); `None` without
+/// such a ref.
+fn referenced(ctx: &mut Ctx, node: &Node) -> Result<Option<BsdfDesc>, LoadError> {
+    let Some(r) = node
+        .children
+        .iter()
+        .find(|c| c.tag == "ref" && matches!(c.name(), "" | "bsdf"))
+    else {
+        return Ok(None);
+    };
+    r.used.set(true);
+    let id = r.req("id")?;
+    let found = ctx.bsdf_ids.get(id).and_then(|name| {
+        ctx.desc
+            .materials
+            .iter()
+            .find(|m| &m.name == name)
+            .map(|m| m.bsdf.clone())
+    });
+    match found {
+        Some(d) => Ok(Some(d)),
+        None => Err(r.error(format!("no <bsdf> defined before it has the id \"{id}\""))),
+    }
 }
 
 /// η and k of a conductor: a `material` preset (default `none`, an ideal mirror), or

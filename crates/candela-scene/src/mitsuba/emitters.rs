@@ -19,7 +19,7 @@ pub(crate) fn emitter(ctx: &mut Ctx, node: &Node) -> Result<(), LoadError> {
             let position = placed(node, "position", Vec3::ZERO)?;
             LightKindDesc::Point {
                 position,
-                intensity: node.color("intensity")?.unwrap_or(Vec3::ONE),
+                intensity: node.illuminant("intensity")?.unwrap_or(Vec3::ONE),
             }
         }
         "spot" => {
@@ -39,7 +39,7 @@ pub(crate) fn emitter(ctx: &mut Ctx, node: &Node) -> Result<(), LoadError> {
                 inner_angle_deg: inner,
                 outer_angle_deg: outer,
                 falloff: SpotFalloff::Mitsuba,
-                color: LightColorDesc::Rgb(node.color("intensity")?.unwrap_or(Vec3::ONE)),
+                color: LightColorDesc::Rgb(node.illuminant("intensity")?.unwrap_or(Vec3::ONE)),
                 amount: LightAmountDesc::WattsPerSr(1.0),
                 profile: None,
             })
@@ -56,7 +56,7 @@ pub(crate) fn emitter(ctx: &mut Ctx, node: &Node) -> Result<(), LoadError> {
             LightKindDesc::Directional(DirectionalLightDesc {
                 direction,
                 // An irradiance (W/m²) on a surface facing the light, per channel.
-                color: LightColorDesc::Rgb(node.color("irradiance")?.unwrap_or(Vec3::ONE)),
+                color: LightColorDesc::Rgb(node.illuminant("irradiance")?.unwrap_or(Vec3::ONE)),
                 amount: LightAmountDesc::WattsPerSr(1.0),
             })
         }
@@ -79,7 +79,7 @@ fn environment(ctx: &mut Ctx, node: &Node) -> Result<(), LoadError> {
     }
     let env = if node.kind() == "constant" {
         EnvironmentDesc {
-            map: EnvironmentMapDesc::Constant(node.color("radiance")?.unwrap_or(Vec3::ONE)),
+            map: EnvironmentMapDesc::Constant(node.illuminant("radiance")?.unwrap_or(Vec3::ONE)),
             span: node.span.clone(),
             ..EnvironmentDesc::default()
         }

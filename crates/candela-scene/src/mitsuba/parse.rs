@@ -119,6 +119,14 @@ impl Node {
             "float" => Ok(Some(Vec3::splat(p.parse_f32(p.req("value")?)?))),
             "rgb" => p.parse_vec3(p.req("value")?, true).map(Some),
             "spectrum" => {
+                if let Some(t) = p.attr("type") {
+                    // Mitsuba 3.9.1's RGB variants refuse `blackbody` as well ("Not
+                    // implemented for non-spectral modes").
+                    return Err(p.error(format!(
+                        "a <spectrum type=\"{t}\"> is not supported (Candela renders RGB); \
+                         give the colour as <rgb>"
+                    )));
+                }
                 let v = p.req("value")?;
                 if v.contains(':') {
                     return Err(p.error(
@@ -134,6 +142,18 @@ impl Node {
         }
     }
 
+    /// An emitter's colour (`radiance`, `intensity`, `irradiance`): as [`Node::color`],
+    /// except that a constant `<spectrum value="v">` is an equal-energy spectrum of v,
+    /// which Mitsuba's RGB variants turn into v·[`EQUAL_ENERGY_RGB`] where they read it
+    /// as an illuminant (a BSDF's constant spectrum stays v in every channel).
+    pub fn illuminant(&self, name: &str) -> Result<Option<Vec3>, LoadError> {
+        let scale = match self.children.iter().find(|c| c.name() == name) {
+            Some(c) if c.tag == "spectrum" => EQUAL_ENERGY_RGB,
+            _ => Vec3::ONE,
+        };
+        Ok(self.color(name)?.map(|c| c * scale))
+    }
+
     /// A `point` or `vector`: `x`/`y`/`z` attributes (missing ones are 0) or `value`.
     pub fn point(&self, name: &str) -> Result<Option<Vec3>, LoadError> {
         self.prop(name)
@@ -141,7 +161,7 @@ impl Node {
             .transpose()
     }
 
-    fn typed(&self, tags: &[&str]) -> Result<&Node, LoadError> {
+    pub fn typed(&self, tags: &[&str]) -> Result<&Node, LoadError> {
         if tags.contains(&self.tag.as_str()) {
             Ok(self)
         } else {
@@ -188,6 +208,34 @@ impl Node {
         }
     }
 }
+
+/// Mitsuba's camelCase to snake_case for upgraded scenes, matching what Mitsuba 3.9.1
+/// makes of these names: `toWorld` → `to_world`, `intIOR` → `int_ior`, `fooBAR` →
+/// `foo_bar`, `foo2Bar` and a leading capital unchanged (`FooBar` → `Foo_bar`).
+pub(crate) fn snake_case(name: &str) -> String {
+    let mut out = String::with_capacity(name.len() + 4);
+    let (mut prev_lower, mut in_run) = (false, false);
+    for c in name.chars() {
+        if c.is_ascii_uppercase() {
+            if prev_lower {
+                out.push('_');
+                in_run = true;
+            }
+            out.push(if in_run { c.to_ascii_lowercase() } else { c });
+            prev_lower = false;
+        } else {
+            out.push(c);
+            prev_lower = c.is_ascii_lowercase();
+            in_run = false;
+        }
+    }
+    out
+}
+
+/// Linear Rec.709 RGB of the equal-energy spectrum of value 1 as Mitsuba 3.9.1's RGB
+/// variants compute it: `mi.traverse(mi.load_string('<emitter version="3.0.0"
+/// type="point"><spectrum name="intensity" value="1"/></emitter>'))['intensity.value']`.
+pub(crate) const EQUAL_ENERGY_RGB: Vec3 = Vec3::new(1.20479, 0.948291, 0.908916);
 
 /// Elements that are properties of the plugin they sit in.
 pub(crate) fn is_property(tag: &str) -> bool {
@@ -254,13 +302,24 @@ impl Parser {
                 ),
             ));
         }
+        // Mitsuba 3 reads scenes of version 0.x and 1.x (Mitsuba 0.6 syntax) by renaming
+        // their camelCase property names (`toWorld`, `intIOR`, `sampleCount`) to
+        // snake_case, as its parser's `upgrade_tree` does.
+        let mut upgrade = false;
         if let Some(v) = root.attribute("version") {
-            let major = v.split('.').next().and_then(|m| m.parse::<u32>().ok());
-            if major.is_none_or(|m| m < 2) {
-                return Err(src.error(
-                    root.range().start,
-                    format!("scene version \"{v}\" is not supported; Mitsuba 2 or 3 syntax (version=\"3.0.0\") is"),
-                ));
+            match v
+                .split('.')
+                .next()
+                .and_then(|m| m.trim().parse::<u32>().ok())
+            {
+                Some(0 | 1) => upgrade = true,
+                Some(_) => {}
+                None => {
+                    return Err(src.error(
+                        root.range().start,
+                        format!("scene version \"{v}\" is not a version number (e.g. \"3.0.0\")"),
+                    ))
+                }
             }
         }
         // Defaults first, wherever they are among the scene's children.
@@ -274,7 +333,7 @@ impl Parser {
                 .entry(name.to_string())
                 .or_insert_with(|| value.to_string());
         }
-        let mut scene = self.convert(&src, root, 0)?;
+        let mut scene = self.convert(&src, root, 0, upgrade)?;
         let mut children = Vec::new();
         for c in std::mem::take(&mut scene.children) {
             match c.tag.as_str() {
@@ -299,7 +358,13 @@ impl Parser {
         self.parse_text(&file, &text, depth + 1)
     }
 
-    fn convert(&self, src: &Source, e: roxmltree::Node, depth: usize) -> Result<Node, LoadError> {
+    fn convert(
+        &self,
+        src: &Source,
+        e: roxmltree::Node,
+        depth: usize,
+        upgrade: bool,
+    ) -> Result<Node, LoadError> {
         let at = e.range().start;
         if depth >= MAX_NESTING {
             return Err(src.error(
@@ -312,13 +377,28 @@ impl Parser {
             let value = self
                 .substitute(a.value())
                 .map_err(|m| src.error(a.range().start, m))?;
+            let value = if upgrade && a.name() == "name" && !e.has_tag_name("default") {
+                snake_case(&value)
+            } else {
+                value
+            };
             attrs.push((a.name().to_string(), value));
         }
-        let children = e
+        let mut children: Vec<Node> = e
             .children()
             .filter(|c| c.is_element())
-            .map(|c| self.convert(src, c, depth + 1))
+            .map(|c| self.convert(src, c, depth + 1, upgrade))
             .collect::<Result<_, _>>()?;
+        // Mitsuba 0.6's `diffuse` also took `diffuseReflectance`, which Mitsuba 3 renames.
+        if upgrade && e.has_tag_name("bsdf") && e.attribute("type") == Some("diffuse") {
+            for c in &mut children {
+                for (k, v) in &mut c.attrs {
+                    if k == "name" && v == "diffuse_reflectance" {
+                        *v = "reflectance".to_string();
+                    }
+                }
+            }
+        }
         Ok(Node {
             tag: e.tag_name().name().to_string(),
             attrs,

@@ -69,13 +69,7 @@ pub(crate) fn sensor(ctx: &mut Ctx, node: &Node) -> Result<(), LoadError> {
         Some(t) => transform::transform(t)?,
         None => Mat4::IDENTITY,
     };
-    if node.prop("focal_length").is_some() {
-        return Err(node.error("focal_length is not supported; give the fov"));
-    }
-    let fov = node
-        .float("fov")?
-        .ok_or_else(|| node.error("perspective sensor needs a fov"))?;
-    let axis = node.string("fov_axis")?.unwrap_or("x");
+    let (fov, axis) = field_of_view(node)?;
     let r = &ctx.desc.render;
     let aspect = r.width as f32 / r.height as f32;
     let fov_y_deg = vertical_fov(fov, axis, aspect).ok_or_else(|| {
@@ -91,6 +85,36 @@ pub(crate) fn sensor(ctx: &mut Ctx, node: &Node) -> Result<(), LoadError> {
         ctx.desc.camera.lens = Some(thin_lens(node)?);
     }
     ctx.check_unused(node)
+}
+
+/// The sensor's `fov` (degrees) and the axis it spans. As in Mitsuba's `parse_fov`, a
+/// `focal_length` ("50mm" when neither it nor `fov` is given) is a 35 mm film
+/// equivalent: the fov spans the film's diagonal, 2·atan(√(36² + 24²)/(2f)), and
+/// `fov_axis` is not read (Mitsuba reports it as unused).
+fn field_of_view(node: &Node) -> Result<(f32, &str), LoadError> {
+    let Some(p) = node.prop("focal_length") else {
+        return Ok(match node.float("fov")? {
+            Some(fov) => (fov, node.string("fov_axis")?.unwrap_or("x")),
+            None => (focal_length_fov(50.0), "diagonal"),
+        });
+    };
+    if node.prop("fov").is_some() {
+        return Err(node.error("give a sensor's fov or its focal_length, not both"));
+    }
+    let v = p.typed(&["string", "float"])?.req("value")?;
+    let mm = v.trim().strip_suffix("mm").unwrap_or(v.trim());
+    match mm.parse::<f32>() {
+        Ok(f) if f > 0.0 && f.is_finite() => Ok((focal_length_fov(f), "diagonal")),
+        _ => Err(p.error(format!(
+            "focal_length \"{v}\" is not a positive length in millimetres (e.g. \"50mm\")"
+        ))),
+    }
+}
+
+/// The diagonal fov (degrees) of a lens of focal length `mm` on 36 × 24 mm film.
+fn focal_length_fov(mm: f32) -> f32 {
+    let diagonal = (36.0f32 * 36.0 + 24.0 * 24.0).sqrt();
+    (2.0 * (diagonal / (2.0 * mm)).atan()).to_degrees()
 }
 
 /// Mitsuba's camera frame looks along +z with +y up and the image's right along −x (see

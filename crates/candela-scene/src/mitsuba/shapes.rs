@@ -6,6 +6,7 @@
 use std::sync::Arc;
 
 use candela_core::desc::{BsdfDesc, GeometryDesc, MeshDesc, ShapeDesc, TextureDesc};
+use candela_core::math::Frame;
 use glam::{Mat4, Vec2, Vec3};
 
 use super::parse::Node;
@@ -102,6 +103,7 @@ fn shape_desc(ctx: &mut Ctx, node: &Node) -> Result<Option<ShapeDesc>, LoadError
             center: node.point("center")?.unwrap_or(Vec3::ZERO),
             radius: node.float("radius")?.unwrap_or(1.0),
         },
+        "cylinder" => GeometryDesc::Mesh(Arc::new(cylinder(node)?)),
         "obj" | "ply" => {
             let file = node
                 .string("filename")?
@@ -123,6 +125,9 @@ fn shape_desc(ctx: &mut Ctx, node: &Node) -> Result<Option<ShapeDesc>, LoadError
                         .map_err(|e| node.error(format!("cannot load mesh: {e}")))?;
                     if face_normals {
                         mesh.normals.clear();
+                    } else if mesh.normals.is_empty() {
+                        // Mitsuba smooths a mesh that comes without normals.
+                        mesh.normals = vertex_normals(&mesh);
                     }
                     if flip_uv {
                         mesh.uvs.iter_mut().for_each(|uv| uv.y = 1.0 - uv.y);
@@ -148,6 +153,12 @@ fn shape_desc(ctx: &mut Ctx, node: &Node) -> Result<Option<ShapeDesc>, LoadError
         }
         g => g,
     };
+    let geometry = match geometry {
+        GeometryDesc::Mesh(m) if normal_mapped(ctx, &material) && m.tangents.is_empty() => {
+            GeometryDesc::Mesh(Arc::new(with_tangents(&m)))
+        }
+        g => g,
+    };
 
     let mut emission = None;
     for e in node.plugins("emitter") {
@@ -161,7 +172,7 @@ fn shape_desc(ctx: &mut Ctx, node: &Node) -> Result<Option<ShapeDesc>, LoadError
         if emission.is_some() {
             return Err(e.error("a shape has at most one area emitter"));
         }
-        emission = Some(e.color("radiance")?.unwrap_or(Vec3::ONE));
+        emission = Some(e.illuminant("radiance")?.unwrap_or(Vec3::ONE));
         ctx.check_unused(e)?;
     }
     ctx.check_unused(node)?;
@@ -225,6 +236,127 @@ fn reads_uv(ctx: &Ctx, material: &str) -> bool {
         .iter()
         .find(|m| m.name == material)
         .is_some_and(|m| bsdf(&m.bsdf))
+}
+
+/// Mitsuba's `Mesh::recompute_vertex_normals`, which its `obj` and `ply` shapes apply to
+/// a mesh without normals unless `face_normals` is set: each vertex gets the sum of its
+/// faces' unit normals weighted by the face's angle at the vertex (Thürmer and Wüthrich
+/// 1998), normalized; a vertex with no valid face gets (1, 0, 0), as in Mitsuba.
+pub(crate) fn vertex_normals(mesh: &MeshDesc) -> Vec<Vec3> {
+    // The angle between unit vectors, accurate near 0 and π (Mitsuba's `unit_angle`).
+    fn unit_angle(a: Vec3, b: Vec3) -> f32 {
+        if a.dot(b) < 0.0 {
+            std::f32::consts::PI - 2.0 * ((a + b).length() * 0.5).min(1.0).asin()
+        } else {
+            2.0 * ((a - b).length() * 0.5).min(1.0).asin()
+        }
+    }
+    let mut normals = vec![Vec3::ZERO; mesh.positions.len()];
+    for &[i0, i1, i2] in &mesh.indices {
+        let [p0, p1, p2] = [i0, i1, i2].map(|i| mesh.positions[i as usize]);
+        let n = (p1 - p0).cross(p2 - p0);
+        if n.length_squared() == 0.0 || !n.is_finite() {
+            continue;
+        }
+        let n = n.normalize();
+        let corners = [
+            (i0, p1 - p0, p2 - p0),
+            (i1, p2 - p1, p0 - p1),
+            (i2, p0 - p2, p1 - p2),
+        ];
+        for (i, a, b) in corners {
+            normals[i as usize] += n * unit_angle(a.normalize(), b.normalize());
+        }
+    }
+    for n in &mut normals {
+        *n = n.try_normalize().unwrap_or(Vec3::X);
+    }
+    normals
+}
+
+/// Whether the named material bends its normals by a map.
+fn normal_mapped(ctx: &Ctx, material: &str) -> bool {
+    fn bsdf(b: &BsdfDesc) -> bool {
+        match b {
+            BsdfDesc::NormalMap { .. } => true,
+            BsdfDesc::TwoSided(inner) | BsdfDesc::OneSided(inner) => bsdf(inner),
+            BsdfDesc::Alpha { inner, .. } => bsdf(inner),
+            _ => false,
+        }
+    }
+    ctx.desc
+        .materials
+        .iter()
+        .find(|m| m.name == material)
+        .is_some_and(|m| bsdf(&m.bsdf))
+}
+
+/// The mesh with per-vertex tangents ∂p/∂u (the sum over its faces, normalized) and
+/// handedness +1. Mitsuba's `normalmap` takes its bitangent as n × ∂p/∂u whatever the
+/// uvs' orientation, where Candela without tangents flips it on mirrored uvs (glTF's
+/// rule), which an OBJ's flipped v makes every face.
+fn with_tangents(mesh: &MeshDesc) -> MeshDesc {
+    let mut tangents = vec![Vec3::ZERO; mesh.positions.len()];
+    if mesh.uvs.len() == mesh.positions.len() {
+        for &[i0, i1, i2] in &mesh.indices {
+            let [p0, p1, p2] = [i0, i1, i2].map(|i| mesh.positions[i as usize]);
+            let [t0, t1, t2] = [i0, i1, i2].map(|i| mesh.uvs[i as usize]);
+            let (d1, d2) = (t1 - t0, t2 - t0);
+            let det = d1.x * d2.y - d1.y * d2.x;
+            if det == 0.0 || !det.is_finite() {
+                continue;
+            }
+            let dpdu = ((p1 - p0) * d2.y - (p2 - p0) * d1.y) / det;
+            for i in [i0, i1, i2] {
+                tangents[i as usize] += dpdu;
+            }
+        }
+    }
+    MeshDesc {
+        tangents: tangents
+            .into_iter()
+            .map(|t| t.try_normalize().unwrap_or(Vec3::ZERO).extend(1.0))
+            .collect(),
+        ..mesh.clone()
+    }
+}
+
+/// Segments around a `cylinder`: the flat sides lie within r·(1 − cos(π/128)) ≈ 3·10⁻⁴ r
+/// of the tube and its area is short by 10⁻⁴.
+const CYLINDER_SEGMENTS: u32 = 128;
+
+/// Mitsuba's `cylinder`: an open tube (no caps) of `radius` (1) from `p0` (origin) to `p1`
+/// (0, 0, 1), normals outwards, as a smooth-shaded mesh in the shape's object space (its
+/// `to_world` then applies). Mitsuba's tube is the unit one, z in [0, 1], placed by the
+/// frame of p1 − p0 (`coordinate_system`, i.e. [`Frame::from_z`]); its uv is
+/// (atan2(y, x)/2π, z) in that unit frame.
+fn cylinder(node: &Node) -> Result<MeshDesc, LoadError> {
+    let p0 = node.point("p0")?.unwrap_or(Vec3::ZERO);
+    let p1 = node.point("p1")?.unwrap_or(Vec3::Z);
+    let radius = node.float("radius")?.unwrap_or(1.0);
+    let axis = p1 - p0;
+    if axis.length_squared() == 0.0 || radius <= 0.0 {
+        return Err(node.error("a cylinder needs p0 ≠ p1 and a positive radius"));
+    }
+    let f = Frame::from_z(axis.normalize());
+    let mut mesh = MeshDesc::default();
+    for j in 0..=CYLINDER_SEGMENTS {
+        let u = j as f32 / CYLINDER_SEGMENTS as f32;
+        let (sin, cos) = (u * std::f32::consts::TAU).sin_cos();
+        let radial = f.s * cos + f.t * sin;
+        for v in [0.0, 1.0] {
+            mesh.positions.push(p0 + radial * radius + axis * v);
+            mesh.normals.push(radial);
+            mesh.uvs.push(Vec2::new(u, v));
+        }
+    }
+    for j in 0..CYLINDER_SEGMENTS {
+        let (a, b, c, d) = (2 * j, 2 * j + 2, 2 * j + 3, 2 * j + 1);
+        // Counter-clockwise seen from outside: (s, t, z) is right-handed.
+        mesh.indices.push([a, b, c]);
+        mesh.indices.push([a, c, d]);
+    }
+    Ok(mesh)
 }
 
 /// Rings from pole to pole and segments around the axis of [`uv_sphere`]: the flat

@@ -1,6 +1,7 @@
 //! `<transform>`: a sequence of steps, each applied after (left-multiplied onto) the ones
 //! before it, as in Mitsuba.
 
+use candela_core::math::Frame;
 use glam::{Mat3, Mat4, Vec3};
 
 use super::parse::Node;
@@ -47,9 +48,13 @@ fn step_matrix(s: &Node) -> Result<Mat4, LoadError> {
         "lookat" => {
             let vec = |a: &str| s.parse_vec3(s.req(a)?, false);
             let (origin, target) = (vec("origin")?, vec("target")?);
-            let up = s
-                .attr("up")
-                .map_or(Ok(Vec3::Y), |u| s.parse_vec3(u, false))?;
+            // Without `up`, Mitsuba's parser takes the first axis of its
+            // `coordinate_system` around the view direction (Duff et al. 2017), which is
+            // `Frame::from_z`'s `s`; a lookat without `up` then rolls the camera.
+            let up = match s.attr("up") {
+                Some(u) => s.parse_vec3(u, false)?,
+                None => Frame::from_z((target - origin).normalize_or_zero()).s,
+            };
             look_at(origin, target, up).ok_or_else(|| {
                 s.error("lookat: origin and target coincide, or up is parallel to the view")
             })?
