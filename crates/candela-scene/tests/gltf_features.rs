@@ -845,12 +845,7 @@ fn mirroring_transforms_reverse_the_winding_of_the_front_face() {
 fn accessors_of_a_wrong_format_count_or_stride_are_errors_not_panics() {
     // Each edit makes an accessor that the `gltf` crate's readers would panic on
     // (unreachable!, an assertion, an underflow) or silently misread.
-    let mut base = Glb::new();
-    let q = base.quad(0);
-    base.material(json!({}));
-    let mesh = base.mesh(vec![q]);
-    base.node(json!({ "mesh": mesh }), true);
-    // Accessors of the quad: 0 POSITION, 1 NORMAL, 2 TEXCOORD_0, 3 indices.
+    let base = Glb::one_quad();
     let cases: Vec<(&str, Edit)> = vec![
         (
             "indices: accessors[3] holds Scalar of F32",
@@ -963,11 +958,7 @@ fn sparse_accessors_override_a_base_view_or_zeros() {
 #[test]
 fn scenes_without_nodes_load() {
     // glTF 2.0 §5.17 leaves a scene's `nodes` optional; `gltf-json` 1.4 requires it.
-    let mut g = Glb::new();
-    let q = g.quad(0);
-    g.material(json!({}));
-    let mesh = g.mesh(vec![q]);
-    g.node(json!({ "mesh": mesh }), true);
+    let mut g = Glb::one_quad();
     g.json["scenes"] = json!([{"name": "empty"}, {"nodes": [0]}]);
     g.json["scene"] = json!(1);
     let desc = parse(&g).unwrap().desc;

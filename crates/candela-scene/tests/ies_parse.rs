@@ -1,7 +1,7 @@
 //! Synthetic LM-63 files: each edition, tilt data, each horizontal symmetry, separators,
 //! and every malformed case with the line its error must point at.
 
-use candela_core::photometry::HorizontalSymmetry;
+use candela_core::photometry::{GoniometricTable, HorizontalSymmetry};
 use candela_scene::ies::{parse_ies, IesFile, IesVersion, Tilt};
 
 /// A file from its header lines and its data (everything after TILT=NONE).
@@ -21,6 +21,17 @@ fn error(text: &str) -> (String, u32) {
 
 /// 3 vertical angles (0, 45, 90), one plane, candela 100 80 0, multiplier 2.
 const SIMPLE: &str = "1 1000 2 3 1 1 2 0.1 0.1 0\n1 1 50\n0 45 90\n0\n100 80 0\n";
+
+/// The table's intensity 45° from the nadir axis, at azimuth `phi` degrees.
+fn intensity_at_45_degrees(table: &GoniometricTable, phi: f64) -> f32 {
+    let p = phi.to_radians();
+    let s = std::f64::consts::FRAC_1_SQRT_2;
+    table.intensity(glam::Vec3::new(
+        (s * p.cos()) as f32,
+        (s * p.sin()) as f32,
+        s as f32,
+    ))
+}
 
 #[test]
 fn each_edition_is_recognized() {
@@ -131,15 +142,7 @@ fn each_horizontal_symmetry() {
         let ies = parse(&text);
         assert_eq!(ies.symmetry(), sym, "{angles}");
         let table = ies.table().unwrap();
-        let at = |phi: f64| {
-            let p = phi.to_radians();
-            let s = std::f64::consts::FRAC_1_SQRT_2;
-            table.intensity(glam::Vec3::new(
-                (s * p.cos()) as f32,
-                (s * p.sin()) as f32,
-                s as f32,
-            ))
-        };
+        let at = |phi| intensity_at_45_degrees(&table, phi);
         match sym {
             HorizontalSymmetry::Rotational => assert_eq!(at(123.0), 5.0),
             HorizontalSymmetry::Quadrant => {
@@ -313,15 +316,7 @@ fn bilateral_c90_files_without_a_180_plane_fold_through_it() {
         let ies = parse(&text);
         assert_eq!(ies.symmetry(), HorizontalSymmetry::BilateralC90);
         let table = ies.table().unwrap();
-        let at = |phi: f64| {
-            let p = phi.to_radians();
-            let s = std::f64::consts::FRAC_1_SQRT_2;
-            table.intensity(glam::Vec3::new(
-                (s * p.cos()) as f32,
-                (s * p.sin()) as f32,
-                s as f32,
-            ))
-        };
+        let at = |phi| intensity_at_45_degrees(&table, phi);
         // The mean of the two planes around 180°: 10 (k + 1) for k = n/2 − 1 and n/2.
         let at_180 = 10.0 * (n as f32 + 1.0) / 2.0;
         for (phi, want) in [

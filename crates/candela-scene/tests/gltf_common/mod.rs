@@ -133,6 +133,17 @@ impl Glb {
                "indices": idx, "material": material})
     }
 
+    /// A scene of one [`Glb::quad`] with a default material, its mesh in a root node.
+    /// Accessors: 0 POSITION, 1 NORMAL, 2 TEXCOORD_0, 3 indices.
+    pub fn one_quad() -> Glb {
+        let mut g = Glb::new();
+        let q = g.quad(0);
+        g.material(json!({}));
+        let mesh = g.mesh(vec![q]);
+        g.node(json!({ "mesh": mesh }), true);
+        g
+    }
+
     /// The `.glb` bytes: header, JSON chunk, BIN chunk.
     pub fn bytes(&self) -> Vec<u8> {
         let mut json = self.json.clone();
