@@ -157,16 +157,17 @@ fn camera_rays_match_mitsuba_for_every_fov_axis() {
     ] {
         let props =
             format!(r#"<float name="fov" value="60"/><string name="fov_axis" value="{axis}"/>"#);
-        let lookat = r#"<lookat origin="1,2,3" target="0,0,0" up="0,1,0"/>"#;
-        for (i, got) in film_rays(&props, lookat).into_iter().enumerate() {
-            assert_close(got, Vec3::from_slice(&d[3 * i..]), 2e-5);
-        }
+        assert_film_rays(&props, LOOK_AT_ORIGIN, d);
     }
 }
 
-/// Directions of the camera's rays at film uv (1, 0.5), (0.5, 0), (0, 1) of a 200x100
-/// film, as in `camera_rays_match_mitsuba_for_every_fov_axis`.
-fn film_rays(sensor_props: &str, lookat: &str) -> Vec<Vec3> {
+/// The sensor placement of the camera tests below.
+const LOOK_AT_ORIGIN: &str = r#"<lookat origin="1,2,3" target="0,0,0" up="0,1,0"/>"#;
+
+/// Checks the directions of the camera's rays at film uv (1, 0.5), (0.5, 0), (0, 1) of a
+/// 200x100 film placed by `lookat`, as in `camera_rays_match_mitsuba_for_every_fov_axis`,
+/// against Mitsuba's.
+fn assert_film_rays(sensor_props: &str, lookat: &str, want: [f32; 9]) {
     let xml = scene(&format!(
         r#"<sensor type="perspective">{sensor_props}
              <transform name="to_world">{lookat}</transform>
@@ -175,14 +176,15 @@ fn film_rays(sensor_props: &str, lookat: &str) -> Vec<Vec3> {
     ));
     let desc = load(&xml);
     let cam = Camera::new(&desc.camera, 200, 100);
-    [
+    let film = [
         Vec2::new(200.0, 50.0),
         Vec2::new(100.0, 0.0),
         Vec2::new(0.0, 100.0),
-    ]
-    .into_iter()
-    .map(|film| cam.generate_ray(film).d)
-    .collect()
+    ];
+    for (i, film) in film.into_iter().enumerate() {
+        let got = cam.generate_ray(film).d;
+        assert_close(got, Vec3::from_slice(&want[3 * i..]), 2e-5);
+    }
 }
 
 #[test]
@@ -199,15 +201,12 @@ fn focal_length_and_no_fov_follow_mitsubas_35mm_film() {
         0.0931372, -0.498497, -0.861874, -0.294505, -0.364234, -0.883516, -0.552213, -0.64066,
         -0.533494,
     ];
-    let lookat = r#"<lookat origin="1,2,3" target="0,0,0" up="0,1,0"/>"#;
     for (props, want) in [
         (r#"<string name="focal_length" value="35mm"/>"#, mm35),
         (r#"<string name="focal_length" value="35"/>"#, mm35),
         ("", mm50),
     ] {
-        for (i, got) in film_rays(props, lookat).into_iter().enumerate() {
-            assert_close(got, Vec3::from_slice(&want[3 * i..]), 2e-5);
-        }
+        assert_film_rays(props, LOOK_AT_ORIGIN, want);
     }
     // Both, or a length that is not one, are errors at their element.
     let e = load_err(&scene(
@@ -231,18 +230,16 @@ fn focal_length_and_no_fov_follow_mitsubas_35mm_film() {
 #[test]
 fn lookat_without_up_rolls_the_frame_as_mitsuba_does() {
     // Mitsuba takes `up` from `coordinate_system(view direction)` when it is missing:
-    //   film_rays as above, fov 60, <lookat origin='1,2,3' target='0,0,0'/>
+    //   assert_film_rays' script as above, fov 60, <lookat origin='1,2,3' target='0,0,0'/>
     let want = [
         -0.191812, -0.883623, -0.427104, 0.00957874, -0.535543, -0.844454, -0.495925, -0.0217069,
         -0.868094,
     ];
-    let rays = film_rays(
+    assert_film_rays(
         r#"<float name="fov" value="60"/>"#,
         r#"<lookat origin="1,2,3" target="0,0,0"/>"#,
+        want,
     );
-    for (i, got) in rays.into_iter().enumerate() {
-        assert_close(got, Vec3::from_slice(&want[3 * i..]), 2e-5);
-    }
     // Looking straight down: Mitsuba's bbox of the unit rectangle is [0,2]×{2}×[2,4].
     //   mi.load_string("<shape version='3.0.0' type='rectangle'><transform name='to_world'>"
     //     "<lookat origin='1,2,3' target='1,-1,3'/></transform></shape>").bbox()
