@@ -907,3 +907,33 @@ fn the_example_scene_loads_cleanly_and_builds() {
     assert_close(b.min, Vec3::new(-1.0, 0.0, -1.0), 1e-5);
     assert_close(b.max, Vec3::new(1.0, 2.0, 1.0), 1e-5);
 }
+
+#[test]
+fn clip_planes_that_would_cut_the_scene_are_warned_of() {
+    let warnings = |props: &str| {
+        let xml = scene(&format!(r#"<sensor type="perspective">{props}</sensor>"#));
+        let (_dir, r) = load_files(&[("scene.xml", &xml)], &[], false);
+        let loaded = r.unwrap_or_else(|e| panic!("{e}"));
+        loaded
+            .warnings
+            .iter()
+            .map(|w| w.to_string())
+            .collect::<Vec<_>>()
+    };
+    // Mitsuba's defaults, or planes that cut less, say nothing.
+    assert!(warnings("").is_empty());
+    assert!(warnings(
+        r#"<float name="near_clip" value="0.01"/><float name="far_clip" value="1e5"/>"#
+    )
+    .is_empty());
+    let w = warnings(r#"<float name="near_clip" value="2"/><float name="far_clip" value="50"/>"#);
+    assert_eq!(w.len(), 2, "{w:?}");
+    assert!(
+        w[0].contains("scene.xml:2:") && w[0].contains("near_clip 2") && w[0].contains("nearer"),
+        "{w:?}"
+    );
+    assert!(
+        w[1].contains("far_clip 50") && w[1].contains("beyond"),
+        "{w:?}"
+    );
+}

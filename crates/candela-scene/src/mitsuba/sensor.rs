@@ -77,8 +77,27 @@ pub(crate) fn sensor(ctx: &mut Ctx, node: &Node) -> Result<(), LoadError> {
             "fov_axis \"{axis}\" is not one of x, y, diagonal, smaller, larger"
         ))
     })?;
-    for clip in ["near_clip", "far_clip"] {
-        node.float(clip)?;
+    // Candela does not clip. Mitsuba's defaults (0.01 and 10⁴) rarely cut anything; other
+    // values may be meant to, so those are pointed out.
+    for (clip, default, side) in [
+        ("near_clip", 0.01, "nearer than"),
+        ("far_clip", 1e4, "beyond"),
+    ] {
+        let Some(v) = node.float(clip)? else {
+            continue;
+        };
+        let cuts_more = if clip == "near_clip" {
+            v > default
+        } else {
+            v < default
+        };
+        if cuts_more {
+            let p = node.prop(clip).expect("read just now");
+            ctx.warn(
+                p,
+                format!("{clip} {v}: Candela does not clip, so geometry {side} it is visible"),
+            );
+        }
     }
     ctx.desc.camera = camera(ctx, node, to_world, fov_y_deg)?;
     if node.kind() == "thinlens" {
