@@ -624,11 +624,21 @@ fn build_material(bsdf: &BsdfDesc, span: &Span) -> Result<Material, BuildError> 
                 }
             }
         }
-        BsdfDesc::Plastic { albedo, eta } => {
+        BsdfDesc::Plastic {
+            albedo,
+            eta,
+            alpha,
+            distribution,
+            linear,
+        } => {
             check_eta(span, *eta)?;
+            let distrib = microfacet(span, *alpha, *alpha, *distribution)?;
             Material::Plastic {
                 albedo: build_texture(albedo, span, "albedo")?,
-                coat: Plastic::new(Vec3::ONE, *eta),
+                coat: Plastic {
+                    linear: *linear,
+                    ..Plastic::rough(Vec3::ONE, *eta, distrib)
+                },
             }
         }
         BsdfDesc::MetalRough {

@@ -183,8 +183,17 @@ pub enum BsdfDesc {
         /// constant one for clear glass. Not for thin sheets.
         tint: TextureDesc,
     },
-    /// A diffuse base under a smooth dielectric coat of index `eta`.
-    Plastic { albedo: TextureDesc, eta: f32 },
+    /// A diffuse base under a dielectric coat of index `eta`, smooth (`alpha` 0) or rough
+    /// (isotropic microfacets of roughness `alpha`); see [`crate::bsdf::Plastic`].
+    Plastic {
+        albedo: TextureDesc,
+        eta: f32,
+        alpha: f32,
+        distribution: MicrofacetDesc,
+        /// The base term ρ/(1 − F_dr) (Mitsuba's default) instead of Candela's
+        /// ρ/(1 − ρ F_dr), which saturates colours by the light the coat keeps inside.
+        linear: bool,
+    },
     /// glTF 2.0 metallic-roughness: metallic and roughness read the texture's first
     /// channel (or the one an image texture selects) and lie in [0, 1].
     MetalRough {

@@ -21,7 +21,7 @@ pub enum Material {
     Fixed(Lobe),
     Plastic {
         albedo: Texture,
-        /// A template holding η and F_dr (computed once); the albedo is replaced.
+        /// A template holding η, the coat and F_dr (computed once); the albedo is replaced.
         coat: Plastic,
     },
     MetalRough {

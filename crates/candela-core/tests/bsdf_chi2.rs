@@ -9,7 +9,8 @@
 //! Cases cover several incident angles incl. 89° (near grazing), roughness α = 0.01
 //! (near-specular) to 1, anisotropic α, directions from below the surface, and for
 //! dielectrics both sides of the interface over the whole sphere; the rough conductor and
-//! dielectric cases run for both microfacet distributions, GGX and Beckmann.
+//! dielectric cases run for both microfacet distributions, GGX and Beckmann, as do the
+//! rough plastic's (coat lobe plus diffuse base).
 //!
 //! Significance: α = 0.01 for the whole file, split over its cases by the Šidák
 //! correction ([`sidak_alpha`], m = [`CASES`]). Seeds are fixed, so the file either
@@ -24,7 +25,7 @@ use candela_core::sampler::Pcg32;
 use glam::{Vec2, Vec3};
 
 /// Number of chi-square cases in this file (for the Šidák correction).
-const CASES: usize = 137;
+const CASES: usize = 155;
 
 fn dir(theta_deg: f32, phi_deg: f32) -> Vec3 {
     let (t, p) = (theta_deg.to_radians(), phi_deg.to_radians());
@@ -38,7 +39,8 @@ fn chi2_case(name: &str, lobe: Lobe, wo: Vec3, seed: u64) {
     // than a cell, most of all in cos θ near the poles: integrate them on a finer grid.
     let narrow = match lobe {
         Lobe::Conductor(Conductor { distrib, .. })
-        | Lobe::Dielectric(Dielectric { distrib, .. }) => {
+        | Lobe::Dielectric(Dielectric { distrib, .. })
+        | Lobe::Plastic(Plastic { distrib, .. }) => {
             let (ax, ay) = distrib.alpha();
             ax.min(ay) < 0.05
         }
@@ -252,6 +254,17 @@ fn plastic_and_metal_rough() {
         seed += 1;
         let lobe = Lobe::Plastic(Plastic::new(Vec3::new(0.8, 0.3, 0.1), 1.5));
         chi2_case(&format!("plastic θo={th}"), lobe, dir(th, 0.0), seed);
+    }
+    for (dname, make) in [GGX, BECKMANN] {
+        for a in [0.05, 0.3, 1.0] {
+            for th in [10.0, 60.0, 85.0] {
+                seed += 1;
+                let rough = Plastic::rough(Vec3::new(0.8, 0.3, 0.1), 1.5, make(a, a));
+                let lobe = Lobe::Plastic(rough);
+                let name = format!("rough plastic {dname} α={a} θo={th}");
+                chi2_case(&name, lobe, dir(th, 0.0), seed);
+            }
+        }
     }
     for (metal, rough) in [(0.0, 0.5), (1.0, 0.3), (0.5, 0.8), (0.0, 0.1)] {
         for th in [20.0, 70.0, 88.0] {

@@ -163,7 +163,7 @@ fn allowed_keys(kind: &str) -> &'static [&'static str] {
             "distribution",
         ],
         "dielectric" => &["eta", "alpha", "alpha_u", "alpha_v", "distribution", "thin"],
-        "plastic" => &["albedo", "eta"],
+        "plastic" => &["albedo", "eta", "alpha", "distribution"],
         "metal_rough" => &["base_color", "metallic", "roughness"],
         _ => &[],
     }
@@ -252,6 +252,9 @@ pub(crate) fn parse_material(
         "plastic" => BsdfDesc::Plastic {
             albedo: tex(m.albedo, Vec3::splat(DEFAULT_ALBEDO), Slot::Color)?,
             eta: scalar_eta(src, m.eta)?,
+            alpha: m.alpha.map_or(0.0, |n| n.0),
+            distribution,
+            linear: false,
         },
         "metal_rough" => BsdfDesc::MetalRough {
             base_color: tex(m.base_color, Vec3::ONE, Slot::Color)?,

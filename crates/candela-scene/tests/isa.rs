@@ -46,11 +46,12 @@ fn film_bits(file: &str, isa: Isa) -> (Vec<u64>, u64) {
     (bits, result.stats.rays)
 }
 
-const SCENES: [&str; 9] = [
+const SCENES: [&str; 10] = [
     "cornell.toml",
     "glass_sphere.toml",
     "rough_metals.toml",
     "microfacets.toml",
+    "plastics.toml",
     "dof.toml",
     "ies-room.toml",
     "environment.toml",

@@ -43,7 +43,12 @@ fn every_material_type_parses() {
     ));
     assert!(matches!(
         material("type = \"plastic\"\nalbedo = [0.1, 0.2, 0.3]").unwrap(),
-        BsdfDesc::Plastic { eta, albedo: TextureDesc::Constant(c) } if eta == 1.5 && c == Vec3::new(0.1, 0.2, 0.3)
+        BsdfDesc::Plastic { eta, albedo: TextureDesc::Constant(c), alpha, linear: false, .. }
+            if eta == 1.5 && c == Vec3::new(0.1, 0.2, 0.3) && alpha == 0.0
+    ));
+    assert!(matches!(
+        material("type = \"plastic\"\nalpha = 0.2\ndistribution = \"beckmann\"").unwrap(),
+        BsdfDesc::Plastic { alpha, distribution: MicrofacetDesc::Beckmann, .. } if alpha == 0.2
     ));
     assert!(matches!(
         material("type = \"metal_rough\"\nbase_color = 0.9\nmetallic = 1\nroughness = 0.4\ntwo_sided = true").unwrap(),
@@ -137,7 +142,7 @@ fn errors_point_at_the_key() {
             "type = \"conductor\"\nalpha = 0.2\ndistribution = \"phong\"",
             "scene.toml:4:16: unknown variant `phong`, expected `ggx` or `beckmann`",
         ),
-        ("type = \"plastic\"\ndistribution = \"ggx\"", "scene.toml:3:1: unknown key `distribution`"),
+        ("type = \"plastic\"\nalpha_u = 0.2", "scene.toml:3:1: unknown key `alpha_u`"),
     ];
     for (body, want) in cases {
         let e = material(body).unwrap_err();

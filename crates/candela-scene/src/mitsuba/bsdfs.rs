@@ -3,13 +3,9 @@
 //! so an unwrapped one becomes [`BsdfDesc::OneSided`]. Dielectrics are two-sided in both.
 
 use candela_core::alpha::AlphaMode;
-use std::sync::Arc;
 
-use candela_core::bsdf::fresnel::fresnel_diffuse_reflectance;
 use candela_core::bsdf::metal_preset;
-use candela_core::desc::{
-    AlphaDesc, BsdfDesc, ImageDesc, ImageTextureDesc, MaterialDesc, MicrofacetDesc, TextureDesc,
-};
+use candela_core::desc::{AlphaDesc, BsdfDesc, MaterialDesc, MicrofacetDesc, TextureDesc};
 use glam::Vec3;
 
 use super::parse::Node;
@@ -143,24 +139,18 @@ fn two_sided(ctx: &mut Ctx, node: &Node) -> Result<BsdfDesc, LoadError> {
         }
         "plastic" | "roughplastic" => {
             let eta = ior(node, "int_ior", 1.49)? / ior(node, "ext_ior", 1.000277)?;
-            if kind == "roughplastic" {
-                roughness(node, true)?;
-                ctx.warn(
-                    node,
-                    "roughplastic: Candela's plastic has a smooth coat, so the highlight is \
-                     sharp where Mitsuba's is blurred by alpha",
-                );
+            let (alpha_u, alpha_v, distribution) = roughness(node, kind == "roughplastic")?;
+            if alpha_u != alpha_v {
+                return Err(node.error("roughplastic takes one alpha, not alpha_u and alpha_v"));
             }
             unit_only(ctx, node, "specular_reflectance")?;
-            let albedo = ctx.texture(node, "diffuse_reflectance", Vec3::splat(0.5))?;
-            // Candela's plastic is Mitsuba's `nonlinear` one; the default (linear) one
-            // is the same lobe with another albedo.
-            let albedo = if node.boolean("nonlinear")?.unwrap_or(false) {
-                albedo
-            } else {
-                linear_plastic_albedo(albedo, fresnel_diffuse_reflectance(1.0 / eta))
-            };
-            BsdfDesc::Plastic { albedo, eta }
+            BsdfDesc::Plastic {
+                albedo: ctx.texture(node, "diffuse_reflectance", Vec3::splat(0.5))?,
+                eta,
+                alpha: alpha_u,
+                distribution,
+                linear: !node.boolean("nonlinear")?.unwrap_or(false),
+            }
         }
         "mask" | "normalmap" => return wrapper(ctx, node, true),
         "twosided" => return Err(node.error("twosided inside twosided")),
@@ -237,35 +227,6 @@ fn wrapper(ctx: &mut Ctx, node: &Node, in_two_sided: bool) -> Result<BsdfDesc, L
     };
     ctx.check_unused(node)?;
     Ok(d)
-}
-
-/// The albedo ρ′ under which Candela's plastic (Mitsuba's `nonlinear` one, whose diffuse
-/// term is ρ/(1 − ρ·F_dr)) equals Mitsuba's default, linear plastic of albedo ρ, whose
-/// term is ρ/(1 − F_dr) (its `plastic.cpp`; F_dr is the coat's internal diffuse Fresnel
-/// reflectance): ρ′/(1 − ρ′F_dr) = ρ/(1 − F_dr) gives ρ′ = ρ/(1 − F_dr + ρF_dr), which
-/// stays ≤ 1 for ρ ≤ 1. Applied per texel to images (bilinear filtering then blends the
-/// mapped texels, a difference of second order) and to each checkerboard colour.
-fn linear_plastic_albedo(albedo: TextureDesc, fdr: f32) -> TextureDesc {
-    let map = |rho: Vec3| rho / (Vec3::splat(1.0 - fdr) + rho * fdr);
-    match albedo {
-        TextureDesc::Constant(c) => TextureDesc::Constant(map(c)),
-        TextureDesc::Checker { a, b, uv_transform } => TextureDesc::Checker {
-            a: map(a),
-            b: map(b),
-            uv_transform,
-        },
-        TextureDesc::Image(t) => {
-            let pixels = t.image.pixels.iter().map(|&p| map(p * t.scale)).collect();
-            TextureDesc::Image(ImageTextureDesc {
-                image: Arc::new(ImageDesc {
-                    pixels,
-                    ..ImageDesc::clone(&t.image)
-                }),
-                scale: Vec3::ONE,
-                ..t
-            })
-        }
-    }
 }
 
 /// The BSDF a wrapper's single `<ref id>` (one not naming a texture slot) refers to, as
