@@ -49,12 +49,15 @@ pub fn run(path: &Path, load: &LoadArgs) -> Result<(), UserError> {
     let names: Vec<&str> = desc.materials.iter().map(|m| m.name.as_str()).collect();
     println!("materials  {} ({})", names.len(), names.join(", "));
     let c = &desc.camera;
+    let view = match c.ortho_height {
+        Some(h) => format!("orthographic, {h} high"),
+        None => format!("vertical fov {}°", c.vertical_fov_deg()),
+    };
     println!(
-        "camera     at {:?} looking at {:?}, up {:?}, vertical fov {}°",
+        "camera     at {:?} looking at {:?}, up {:?}, {view}",
         c.position.to_array(),
         c.look_at.to_array(),
         c.up.to_array(),
-        c.vertical_fov_deg()
     );
     println!(
         "bounds     {:?} to {:?}",

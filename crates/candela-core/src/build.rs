@@ -410,6 +410,17 @@ fn build_camera(desc: &SceneDesc) -> Result<Camera, BuildError> {
             ),
         );
     }
+    if let Some(h) = c.ortho_height {
+        if !(h.is_finite() && h > 0.0) {
+            return err(
+                &c.span,
+                format!("orthographic view height {h} must be positive"),
+            );
+        }
+        if c.lens.is_some() {
+            return err(&c.span, "an orthographic camera takes no lens");
+        }
+    }
     if let Some(lens) = &c.lens {
         validate_lens(c, lens)?;
     }

@@ -75,6 +75,10 @@ pub struct CameraDesc {
     pub sensor_mm: Vec2,
     /// A thin lens for depth of field; `None` is a pinhole.
     pub lens: Option<LensDesc>,
+    /// An orthographic camera's view height in world units (its width follows the
+    /// image's aspect): parallel rays along the view direction from the camera's plane,
+    /// and no field of view. `None` for a perspective camera.
+    pub ortho_height: Option<f32>,
     pub span: Span,
 }
 
@@ -88,6 +92,7 @@ impl Default for CameraDesc {
             focal_length_mm: None,
             sensor_mm: Vec2::new(36.0, 24.0),
             lens: None,
+            ortho_height: None,
             span: Span::code(),
         }
     }

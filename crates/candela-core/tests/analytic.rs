@@ -378,3 +378,47 @@ fn point_light_over_a_diffuse_plane() {
         );
     }
 }
+
+/// An orthographic camera sees sizes as they are, whatever the distance. It looks down −y
+/// at an emitting square of side 1 (radiance 1, nothing else in the scene) over a view 4
+/// high on a 32 × 32 film, so 8 × 8 pixels, aligned with the square's edges, see the
+/// square and the rest see nothing: with the box filter every pixel is exactly 1 or 0
+/// (up to the f32 rounding of a sample on an edge), at distance 1 and at 20 alike. A
+/// perspective camera's square would shrink 20-fold between the two, and a view half or
+/// twice as high would cover 4 or 16 times the pixels.
+#[test]
+fn an_orthographic_camera_sees_true_sizes_at_any_distance() {
+    for distance in [1.0, 20.0] {
+        for sampler in SAMPLERS {
+            let mut desc = SceneDesc {
+                camera: CameraDesc {
+                    position: Vec3::new(0.0, distance, 0.0),
+                    look_at: Vec3::ZERO,
+                    up: Vec3::Z,
+                    ortho_height: Some(4.0),
+                    span: Span::code(),
+                    ..Default::default()
+                },
+                render: settings(sampler, MisMode::Balance, 1, 4, 9),
+                ..Default::default()
+            };
+            desc.materials.push(material("black", 0.0));
+            desc.shapes.push(ShapeDesc {
+                transform: Mat4::from_rotation_x(-std::f32::consts::FRAC_PI_2)
+                    * Mat4::from_scale(Vec3::splat(0.5)),
+                ..shape(GeometryDesc::Rectangle, "black", Some(1.0), false)
+            });
+            let px = render_pixels(&desc);
+            let side = 32;
+            for (i, v) in px.iter().enumerate() {
+                let (x, y) = (i % side, i / side);
+                let inside = (12..20).contains(&x) && (12..20).contains(&y);
+                let want = if inside { 1.0 } else { 0.0 };
+                assert!(
+                    (v - want).abs() < 1e-3,
+                    "distance {distance}, {sampler:?}: pixel ({x}, {y}) = {v}, want {want}"
+                );
+            }
+        }
+    }
+}

@@ -1,5 +1,6 @@
-//! The `[camera]` table: a pinhole, or a thin lens with a disc, polygon or image aperture.
-//! The two types take different keys, so a lens key on a pinhole is an unknown key.
+//! The `[camera]` table: a pinhole, a thin lens with a disc, polygon or image aperture, or
+//! an orthographic camera. The types take different keys, so a lens key on a pinhole is
+//! an unknown key.
 
 use std::path::Path;
 
@@ -23,6 +24,17 @@ struct PinholeSection {
     fov: Option<Num>,
     focal_length: Option<Spanned<Num>>,
     sensor: Option<V2>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct OrthographicSection {
+    #[serde(rename = "type")]
+    _kind: String,
+    position: Option<V3>,
+    look_at: Option<V3>,
+    up: Option<V3>,
+    height: Option<Num>,
 }
 
 #[derive(Deserialize)]
@@ -55,7 +67,12 @@ pub(crate) fn parse_camera(
         .as_table()
         .is_some_and(|t| t.contains_key("type"));
     let kind = if has_type {
-        item_type(src, "camera", &value, &["pinhole", "thin_lens"])?
+        item_type(
+            src,
+            "camera",
+            &value,
+            &["pinhole", "thin_lens", "orthographic"],
+        )?
     } else {
         "pinhole"
     };
@@ -75,6 +92,20 @@ pub(crate) fn parse_camera(
             c.focal_length,
             c.sensor,
         );
+    }
+    if kind == "orthographic" {
+        let c: OrthographicSection = deserialize(src, value)?;
+        let Some(Num(height)) = c.height else {
+            return Err(src.error(
+                key_at,
+                "an orthographic camera needs `height`, its view's height in scene units",
+            ));
+        };
+        let d = frame(src, d, c.position, c.look_at, c.up, None, None, None)?;
+        return Ok(CameraDesc {
+            ortho_height: Some(height),
+            ..d
+        });
     }
     let c: ThinLensSection = deserialize(src, value)?;
     let mut d = frame(

@@ -842,6 +842,33 @@ fn mirroring_transforms_reverse_the_winding_of_the_front_face() {
 }
 
 #[test]
+fn orthographic_cameras_view_twice_ymag_at_the_aspect_of_xmag_over_ymag() {
+    let mut g = Glb::one_quad();
+    g.json["cameras"] = json!([{"type": "orthographic",
+        "orthographic": {"xmag": 3.0, "ymag": 1.5, "znear": 0.1, "zfar": 100.0}}]);
+    g.node(json!({"camera": 0, "translation": [0.0, 0.0, 4.0]}), true);
+    let loaded = parse(&g).unwrap();
+    let w = &loaded.warnings;
+    assert!(!w.iter().any(|w| w.contains("camera")), "{w:?}");
+    let (c, r) = (&loaded.desc.camera, &loaded.desc.render);
+    assert_eq!(c.ortho_height, Some(3.0));
+    assert_eq!(c.position, Vec3::new(0.0, 0.0, 4.0));
+    assert!((c.look_at - Vec3::new(0.0, 0.0, 3.0)).length() < 1e-6);
+    assert_eq!(r.width, 2 * r.height);
+    // The quad (2 × 2 at the origin) fills the middle 2/3 of the height and 1/3 of the
+    // width: its corner ray starts at the quad's corner.
+    let cam = candela_core::camera::Camera::new(c, r.width, r.height);
+    let (w, h) = (r.width as f32, r.height as f32);
+    let ray = cam.generate_ray(glam::Vec2::new(w / 3.0, h / 6.0));
+    assert!(
+        (ray.o - Vec3::new(-1.0, 1.0, 4.0)).length() < 1e-4,
+        "{}",
+        ray.o
+    );
+    assert!((ray.d - Vec3::NEG_Z).length() < 1e-6);
+}
+
+#[test]
 fn accessors_of_a_wrong_format_count_or_stride_are_errors_not_panics() {
     // Each edit makes an accessor that the `gltf` crate's readers would panic on
     // (unreachable!, an assertion, an underflow) or silently misread.

@@ -46,12 +46,13 @@ fn film_bits(file: &str, isa: Isa) -> (Vec<u64>, u64) {
     (bits, result.stats.rays)
 }
 
-const SCENES: [&str; 10] = [
+const SCENES: [&str; 11] = [
     "cornell.toml",
     "glass_sphere.toml",
     "rough_metals.toml",
     "microfacets.toml",
     "plastics.toml",
+    "isometric.toml",
     "dof.toml",
     "ies-room.toml",
     "environment.toml",

@@ -937,3 +937,50 @@ fn clip_planes_that_would_cut_the_scene_are_warned_of() {
         "{w:?}"
     );
 }
+
+#[test]
+fn orthographic_rays_match_mitsubas() {
+    // Mitsuba's rays at film uv (1, 0.5), (0.5, 0), (0, 1) of a 200x100 film, unscaled and
+    // with to_world scaled by 3 in x and y (its camera space spans [−1, 1] across):
+    //   s = mi.load_dict({'type': 'orthographic', 'to_world': ...look_at([1,2,3], [0,0,0],
+    //     [0,1,0]) [@ scale([3,3,1])], 'film': {'type': 'hdrfilm', 'width': 200, 'height': 100}})
+    //   s.sample_ray(0, 0.5, uv, [0.5, 0.5])[0].o
+    // Mitsuba's origins lie on the near clip plane, 0.01 along the ray; Candela's on the
+    // camera's plane.
+    let plain = [
+        [1.94601, 1.99465, 2.67575],
+        [0.912812, 2.41723, 2.73844],
+        [0.133159, 1.57208, 3.56176],
+    ];
+    let scaled = [
+        [3.84338, 1.99466, 2.04330],
+        [0.743781, 3.26239, 2.23134],
+        [-1.59518, 0.726924, 4.70130],
+    ];
+    let d = -Vec3::new(1.0, 2.0, 3.0).normalize();
+    for (scale, want) in [("", plain), (r#"<scale x="3" y="3"/>"#, scaled)] {
+        let xml = scene(&format!(
+            r#"<sensor type="orthographic">
+                 <transform name="to_world">{scale}<lookat origin="1,2,3" target="0,0,0" up="0,1,0"/></transform>
+                 <film type="hdrfilm"><integer name="width" value="200"/><integer name="height" value="100"/></film>
+               </sensor>"#
+        ));
+        let desc = load(&xml);
+        let cam = Camera::new(&desc.camera, 200, 100);
+        let film = [
+            Vec2::new(200.0, 50.0),
+            Vec2::new(100.0, 0.0),
+            Vec2::new(0.0, 100.0),
+        ];
+        for (film, want) in film.into_iter().zip(want) {
+            let ray = cam.generate_ray(film);
+            assert_close(ray.d, d, 1e-5);
+            assert_close(ray.o + 0.01 * ray.d, Vec3::from(want), 1e-4);
+        }
+    }
+    // Pixels must stay square.
+    let e = load_err(&scene(
+        r#"<sensor type="orthographic"><transform name="to_world"><scale x="2"/></transform></sensor>"#,
+    ));
+    assert!(e.contains("scene.xml:2:1:") && e.contains("square"), "{e}");
+}

@@ -220,3 +220,34 @@ fn documented_thin_lens_example_parses() {
     assert_eq!(lens.size, ApertureSizeDesc::FNumber(1.4));
     assert!((d.camera.vertical_fov_deg() - 16.07).abs() < 0.01);
 }
+
+#[test]
+fn orthographic_cameras_take_a_height_and_no_lens() {
+    let d = parse(
+        "[camera]\ntype = \"orthographic\"\nposition = [0, 5, 0]\nlook_at = [0, 0, 0]\n\
+         up = [0, 0, -1]\nheight = 3.5\n",
+    )
+    .unwrap();
+    assert_eq!(d.camera.ortho_height, Some(3.5));
+    assert_eq!(d.camera.position, Vec3::new(0.0, 5.0, 0.0));
+    assert!(d.camera.lens.is_none());
+    // The height is required; a lens or fov key is not one of its keys.
+    let e = error("[camera]\ntype = \"orthographic\"\n");
+    assert!(
+        e.starts_with("scene.toml:1:2: ") && e.contains("`height`"),
+        "{e}"
+    );
+    let e = error("[camera]\ntype = \"orthographic\"\nheight = 2\nfov = 30\n");
+    assert!(e.contains("scene.toml:4:1") && e.contains("fov"), "{e}");
+    // A view of no height, or a lens put on by the command line, fails the build.
+    let desc = parse("[camera]\ntype = \"orthographic\"\nheight = 0\n").unwrap();
+    let e = candela_core::build::build(&desc).unwrap_err().to_string();
+    assert!(
+        e.starts_with("scene.toml:1:2: ") && e.contains("height 0"),
+        "{e}"
+    );
+    let mut desc = parse("[camera]\ntype = \"orthographic\"\nheight = 2\n").unwrap();
+    desc.camera.lens = Some(Default::default());
+    let e = candela_core::build::build(&desc).unwrap_err().to_string();
+    assert!(e.contains("takes no lens"), "{e}");
+}

@@ -297,6 +297,6 @@ fn toml_syntax_error() {
 fn unknown_camera_type() {
     assert_eq!(
         error("[camera]\ntype = \"fisheye\"\n"),
-        "scene.toml:2:8: unknown camera type `fisheye`, expected one of `pinhole`, `thin_lens`"
+        "scene.toml:2:8: unknown camera type `fisheye`, expected one of `pinhole`, `thin_lens`, `orthographic`"
     );
 }

@@ -1,6 +1,6 @@
 //! Cameras. In its own frame a camera sits at the origin and looks down −z, with +y up
-//! and +x to the right of the image. A camera is a pinhole, or a pinhole with a
-//! [`ThinLens`] for depth of field.
+//! and +x to the right of the image. A camera is a pinhole, a pinhole with a
+//! [`ThinLens`] for depth of field, or orthographic (parallel rays).
 
 mod aperture;
 mod thin_lens;
@@ -33,7 +33,8 @@ impl CameraDesc {
     }
 }
 
-/// A perspective camera: a pinhole, or a thin lens when `lens` is set.
+/// A perspective camera, a pinhole or a thin lens when `lens` is set, or an orthographic
+/// one.
 #[derive(Clone, Debug)]
 pub struct Camera {
     pub position: Vec3,
@@ -45,6 +46,8 @@ pub struct Camera {
     tan_half_fov: f32,
     resolution: Vec2,
     lens: Option<ThinLens>,
+    /// Half the view height of an orthographic camera.
+    ortho_half_height: Option<f32>,
 }
 
 impl Camera {
@@ -68,6 +71,7 @@ impl Camera {
             tan_half_fov: (desc.vertical_fov_deg().to_radians() * 0.5).tan(),
             resolution: Vec2::new(width as f32, height as f32),
             lens,
+            ortho_half_height: desc.ortho_height.map(|h| 0.5 * h),
         }
     }
 
@@ -82,14 +86,23 @@ impl Camera {
         self.lens.is_some()
     }
 
+    /// The film position as x, y in [−1, 1]², +y up, and the image's aspect ratio.
+    #[inline]
+    fn screen(&self, film: Vec2) -> (Vec2, f32) {
+        let ndc = film / self.resolution;
+        let aspect = self.resolution.x / self.resolution.y;
+        (Vec2::new(2.0 * ndc.x - 1.0, 1.0 - 2.0 * ndc.y), aspect)
+    }
+
     /// Direction (camera frame, z = −1) of the pinhole ray through film position `film`.
     #[inline]
     fn pinhole_direction(&self, film: Vec2) -> Vec3 {
-        let ndc = film / self.resolution;
-        let aspect = self.resolution.x / self.resolution.y;
-        let x = (2.0 * ndc.x - 1.0) * self.tan_half_fov * aspect;
-        let y = (1.0 - 2.0 * ndc.y) * self.tan_half_fov;
-        Vec3::new(x, y, -1.0)
+        let (s, aspect) = self.screen(film);
+        Vec3::new(
+            s.x * self.tan_half_fov * aspect,
+            s.y * self.tan_half_fov,
+            -1.0,
+        )
     }
 
     #[inline]
@@ -101,8 +114,20 @@ impl Camera {
     /// centre of the lens: the pinhole ray.
     #[inline]
     pub fn generate_ray(&self, film: Vec2) -> Ray {
+        if let Some(h) = self.ortho_half_height {
+            return self.orthographic_ray(h, film);
+        }
         let d = self.to_world(self.pinhole_direction(film)).normalize();
         Ray::new(self.position, d)
+    }
+
+    /// The orthographic ray through film position `film`: from the camera's plane, along
+    /// the view direction.
+    #[inline(never)]
+    fn orthographic_ray(&self, half_height: f32, film: Vec2) -> Ray {
+        let (s, aspect) = self.screen(film);
+        let o = Vec3::new(s.x * half_height * aspect, s.y * half_height, 0.0);
+        Ray::new(self.position + self.to_world(o), -self.back)
     }
 
     /// The ray through film position `film` from the lens point of the uniform sample
@@ -132,16 +157,26 @@ impl Camera {
     pub fn project(&self, p: Vec3, lens_u: Vec2) -> Option<Vec2> {
         let v = p - self.position;
         let pc = Vec3::new(v.dot(self.right), v.dot(self.up), v.dot(self.back));
-        let on_focus = match &self.lens {
-            Some(lens) => lens.focus_point(pc, lens.sample_point(lens_u))?,
-            None if pc.z < 0.0 => pc / -pc.z,
-            None => return None,
+        // The point on the plane at distance 1 (perspective) or on the camera's plane
+        // (orthographic), and that plane's half height.
+        let (x, y, half_height) = if let Some(h) = self.ortho_half_height {
+            if pc.z >= 0.0 {
+                return None;
+            }
+            (pc.x, pc.y, h)
+        } else {
+            let on_focus = match &self.lens {
+                Some(lens) => lens.focus_point(pc, lens.sample_point(lens_u))?,
+                None if pc.z < 0.0 => pc / -pc.z,
+                None => return None,
+            };
+            let z = -on_focus.z;
+            (on_focus.x / z, on_focus.y / z, self.tan_half_fov)
         };
-        let (x, y) = (on_focus.x / -on_focus.z, on_focus.y / -on_focus.z);
         let aspect = self.resolution.x / self.resolution.y;
         let ndc = Vec2::new(
-            0.5 * (x / (self.tan_half_fov * aspect) + 1.0),
-            0.5 * (1.0 - y / self.tan_half_fov),
+            0.5 * (x / (half_height * aspect) + 1.0),
+            0.5 * (1.0 - y / half_height),
         );
         Some(ndc * self.resolution)
     }
@@ -174,6 +209,34 @@ mod tests {
         assert!((top.d.y - std::f32::consts::FRAC_1_SQRT_2).abs() < 1e-5);
         let right = cam.generate_ray(Vec2::new(200.0, 50.0));
         assert!(right.d.x > 0.0 && (right.d.x / -right.d.z - 2.0).abs() < 1e-5);
+    }
+
+    #[test]
+    fn orthographic_rays_are_parallel_and_span_the_view() {
+        let desc = CameraDesc {
+            position: Vec3::new(1.0, 2.0, 3.0),
+            look_at: Vec3::new(1.0, 2.0, -7.0),
+            up: Vec3::Y,
+            ortho_height: Some(4.0),
+            ..Default::default()
+        };
+        let cam = Camera::new(&desc, 200, 100);
+        for (film, origin) in [
+            (Vec2::new(100.0, 50.0), Vec3::new(1.0, 2.0, 3.0)),
+            // Top edge: 2 up; right edge: 4 right (aspect 2); the top-left corner.
+            (Vec2::new(100.0, 0.0), Vec3::new(1.0, 4.0, 3.0)),
+            (Vec2::new(200.0, 50.0), Vec3::new(5.0, 2.0, 3.0)),
+            (Vec2::new(0.0, 0.0), Vec3::new(-3.0, 4.0, 3.0)),
+        ] {
+            let r = cam.generate_lens_ray(film, Vec2::new(0.3, 0.7));
+            assert!((r.o - origin).length() < 1e-5, "{film}: {}", r.o);
+            assert!((r.d - Vec3::NEG_Z).length() < 1e-6, "{film}: {}", r.d);
+            // Projecting any point of the ray lands on the same film position.
+            let p = cam.project(r.o + 3.5 * r.d, Vec2::ZERO).unwrap();
+            assert!((p - film).length() < 1e-3, "{film}: {p}");
+        }
+        assert!(!cam.needs_lens_sample());
+        assert_eq!(cam.project(Vec3::new(1.0, 2.0, 4.0), Vec2::ZERO), None);
     }
 
     #[test]

@@ -2,8 +2,8 @@
 //!
 //! A glTF camera looks down its node's −z with +y up (the same convention as Candela's).
 //! Perspective cameras keep `yfov`; `aspectRatio`, when given, sets the image height
-//! from the width. Candela has no orthographic camera, so those are skipped (warned) and
-//! the automatic camera is used.
+//! from the width. Orthographic cameras view 2·`ymag` high, and `xmag`/`ymag` is the
+//! aspect they ask for. The clip planes (`znear`, `zfar`) are not applied.
 
 use candela_core::desc::{CameraDesc, GeometryDesc, ShapeDesc};
 use candela_core::geometry::Aabb;
@@ -11,36 +11,33 @@ use glam::{Mat4, Vec3};
 
 use super::Ctx;
 
-/// A node's camera and the aspect ratio it asks for; `None` for orthographic cameras.
-pub(crate) fn camera(
-    ctx: &mut Ctx,
-    c: &gltf::Camera,
-    world: Mat4,
-) -> Option<(CameraDesc, Option<f32>)> {
+/// A node's camera and the aspect ratio it asks for.
+pub(crate) fn camera(ctx: &Ctx, c: &gltf::Camera, world: Mat4) -> (CameraDesc, Option<f32>) {
+    let position = world.transform_point3(Vec3::ZERO);
+    let forward = world.transform_vector3(-Vec3::Z).normalize_or_zero();
+    let up = world.transform_vector3(Vec3::Y).normalize_or_zero();
+    let desc = CameraDesc {
+        position,
+        look_at: position + forward,
+        up,
+        span: ctx.span(),
+        ..CameraDesc::default()
+    };
     match c.projection() {
-        gltf::camera::Projection::Perspective(p) => {
-            let position = world.transform_point3(Vec3::ZERO);
-            let forward = world.transform_vector3(-Vec3::Z).normalize_or_zero();
-            let up = world.transform_vector3(Vec3::Y).normalize_or_zero();
-            Some((
-                CameraDesc {
-                    position,
-                    look_at: position + forward,
-                    up,
-                    fov_y_deg: p.yfov().to_degrees(),
-                    span: ctx.span(),
-                    ..CameraDesc::default()
-                },
-                p.aspect_ratio(),
-            ))
-        }
-        gltf::camera::Projection::Orthographic(_) => {
-            ctx.warn(format!(
-                "cameras[{}]: orthographic cameras are not supported; skipped",
-                c.index()
-            ));
-            None
-        }
+        gltf::camera::Projection::Perspective(p) => (
+            CameraDesc {
+                fov_y_deg: p.yfov().to_degrees(),
+                ..desc
+            },
+            p.aspect_ratio(),
+        ),
+        gltf::camera::Projection::Orthographic(o) => (
+            CameraDesc {
+                ortho_height: Some(2.0 * o.ymag()),
+                ..desc
+            },
+            Some(o.xmag() / o.ymag()),
+        ),
     }
 }
 

@@ -290,7 +290,7 @@ pub fn parse_gltf_scene(
             out.lights.push(light::light(&mut ctx, &l, world)?);
         }
         if let (Some(c), None) = (node.camera(), &out.camera) {
-            out.camera = camera::camera(&mut ctx, &c, world);
+            out.camera = Some(camera::camera(&ctx, &c, world));
         }
         let mut children: Vec<_> = node.children().collect();
         children.reverse();

@@ -56,7 +56,7 @@ pub(crate) fn integrator(ctx: &mut Ctx, node: &Node) -> Result<(), LoadError> {
 
 pub(crate) fn sensor(ctx: &mut Ctx, node: &Node) -> Result<(), LoadError> {
     match node.kind() {
-        "perspective" | "thinlens" => {}
+        "perspective" | "thinlens" | "orthographic" => {}
         _ => return ctx.unsupported(node, format!("<{}> is not supported", describe(node))),
     }
     for f in node.plugins("film") {
@@ -69,14 +69,18 @@ pub(crate) fn sensor(ctx: &mut Ctx, node: &Node) -> Result<(), LoadError> {
         Some(t) => transform::transform(t)?,
         None => Mat4::IDENTITY,
     };
-    let (fov, axis) = field_of_view(node)?;
     let r = &ctx.desc.render;
     let aspect = r.width as f32 / r.height as f32;
-    let fov_y_deg = vertical_fov(fov, axis, aspect).ok_or_else(|| {
-        node.error(format!(
-            "fov_axis \"{axis}\" is not one of x, y, diagonal, smaller, larger"
-        ))
-    })?;
+    let fov_y_deg = if node.kind() == "orthographic" {
+        CameraDesc::default().fov_y_deg
+    } else {
+        let (fov, axis) = field_of_view(node)?;
+        vertical_fov(fov, axis, aspect).ok_or_else(|| {
+            node.error(format!(
+                "fov_axis \"{axis}\" is not one of x, y, diagonal, smaller, larger"
+            ))
+        })?
+    };
     // Candela does not clip. Mitsuba's defaults (0.01 and 10⁴) rarely cut anything; other
     // values may be meant to, so those are pointed out.
     for (clip, default, side) in [
@@ -100,10 +104,29 @@ pub(crate) fn sensor(ctx: &mut Ctx, node: &Node) -> Result<(), LoadError> {
         }
     }
     ctx.desc.camera = camera(ctx, node, to_world, fov_y_deg)?;
-    if node.kind() == "thinlens" {
-        ctx.desc.camera.lens = Some(thin_lens(node)?);
+    match node.kind() {
+        "thinlens" => ctx.desc.camera.lens = Some(thin_lens(node)?),
+        "orthographic" => {
+            ctx.desc.camera.ortho_height = Some(ortho_height(node, to_world, aspect)?)
+        }
+        _ => {}
     }
     ctx.check_unused(node)
+}
+
+/// The view height of Mitsuba's `orthographic` sensor, whose camera space spans
+/// [−1, 1] across the film's width and [−1/aspect, 1/aspect] up it, scaled by `to_world`.
+/// Pixels stay square only where it scales x and y alike.
+fn ortho_height(node: &Node, to_world: Mat4, aspect: f32) -> Result<f32, LoadError> {
+    let sx = to_world.transform_vector3(Vec3::X).length();
+    let sy = to_world.transform_vector3(Vec3::Y).length();
+    if (sx - sy).abs() > 1e-4 * sx.max(sy) {
+        return Err(node.error(format!(
+            "an orthographic sensor's to_world scales x by {sx} and y by {sy}: Candela's pixels \
+             are square, so both must be the same"
+        )));
+    }
+    Ok(2.0 * sx / aspect)
 }
 
 /// The sensor's `fov` (degrees) and the axis it spans. As in Mitsuba's `parse_fov`, a
