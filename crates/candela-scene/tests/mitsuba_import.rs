@@ -9,6 +9,7 @@ use candela_core::camera::Camera;
 use candela_core::desc::{
     BsdfDesc, GeometryDesc, LightKindDesc, SamplerKind, SceneDesc, TextureDesc,
 };
+use candela_core::geometry::Ray;
 use candela_scene::{load_scene_with, LoadError, LoadOptions, LoadedScene};
 use glam::{Vec2, Vec3};
 
@@ -164,26 +165,35 @@ fn camera_rays_match_mitsuba_for_every_fov_axis() {
 /// The sensor placement of the camera tests below.
 const LOOK_AT_ORIGIN: &str = r#"<lookat origin="1,2,3" target="0,0,0" up="0,1,0"/>"#;
 
-/// Checks the directions of the camera's rays at film uv (1, 0.5), (0.5, 0), (0, 1) of a
-/// 200x100 film placed by `lookat`, as in `camera_rays_match_mitsuba_for_every_fov_axis`,
-/// against Mitsuba's.
-fn assert_film_rays(sensor_props: &str, lookat: &str, want: [f32; 9]) {
+/// The camera's rays at film uv (1, 0.5), (0.5, 0), (0, 1) (right edge, top edge,
+/// bottom-left corner) of a 200x100 sensor of type `kind` with `props`, placed by the
+/// `to_world` steps `transform`.
+fn film_rays(kind: &str, props: &str, transform: &str) -> Vec<Ray> {
     let xml = scene(&format!(
-        r#"<sensor type="perspective">{sensor_props}
-             <transform name="to_world">{lookat}</transform>
+        r#"<sensor type="{kind}">{props}
+             <transform name="to_world">{transform}</transform>
              <film type="hdrfilm"><integer name="width" value="200"/><integer name="height" value="100"/></film>
            </sensor>"#
     ));
-    let desc = load(&xml);
-    let cam = Camera::new(&desc.camera, 200, 100);
-    let film = [
+    let cam = Camera::new(&load(&xml).camera, 200, 100);
+    [
         Vec2::new(200.0, 50.0),
         Vec2::new(100.0, 0.0),
         Vec2::new(0.0, 100.0),
-    ];
-    for (i, film) in film.into_iter().enumerate() {
-        let got = cam.generate_ray(film).d;
-        assert_close(got, Vec3::from_slice(&want[3 * i..]), 2e-5);
+    ]
+    .into_iter()
+    .map(|film| cam.generate_ray(film))
+    .collect()
+}
+
+/// Checks the directions of [`film_rays`] of a perspective sensor against Mitsuba's, as in
+/// `camera_rays_match_mitsuba_for_every_fov_axis`.
+fn assert_film_rays(sensor_props: &str, lookat: &str, want: [f32; 9]) {
+    for (i, ray) in film_rays("perspective", sensor_props, lookat)
+        .iter()
+        .enumerate()
+    {
+        assert_close(ray.d, Vec3::from_slice(&want[3 * i..]), 2e-5);
     }
 }
 
@@ -230,7 +240,7 @@ fn focal_length_and_no_fov_follow_mitsubas_35mm_film() {
 #[test]
 fn lookat_without_up_rolls_the_frame_as_mitsuba_does() {
     // Mitsuba takes `up` from `coordinate_system(view direction)` when it is missing:
-    //   assert_film_rays' script as above, fov 60, <lookat origin='1,2,3' target='0,0,0'/>
+    //   film_rays' script as above, fov 60, <lookat origin='1,2,3' target='0,0,0'/>
     let want = [
         -0.191812, -0.883623, -0.427104, 0.00957874, -0.535543, -0.844454, -0.495925, -0.0217069,
         -0.868094,
@@ -959,21 +969,8 @@ fn orthographic_rays_match_mitsubas() {
     ];
     let d = -Vec3::new(1.0, 2.0, 3.0).normalize();
     for (scale, want) in [("", plain), (r#"<scale x="3" y="3"/>"#, scaled)] {
-        let xml = scene(&format!(
-            r#"<sensor type="orthographic">
-                 <transform name="to_world">{scale}<lookat origin="1,2,3" target="0,0,0" up="0,1,0"/></transform>
-                 <film type="hdrfilm"><integer name="width" value="200"/><integer name="height" value="100"/></film>
-               </sensor>"#
-        ));
-        let desc = load(&xml);
-        let cam = Camera::new(&desc.camera, 200, 100);
-        let film = [
-            Vec2::new(200.0, 50.0),
-            Vec2::new(100.0, 0.0),
-            Vec2::new(0.0, 100.0),
-        ];
-        for (film, want) in film.into_iter().zip(want) {
-            let ray = cam.generate_ray(film);
+        let rays = film_rays("orthographic", "", &format!("{scale}{LOOK_AT_ORIGIN}"));
+        for (ray, want) in rays.iter().zip(want) {
             assert_close(ray.d, d, 1e-5);
             assert_close(ray.o + 0.01 * ray.d, Vec3::from(want), 1e-4);
         }
