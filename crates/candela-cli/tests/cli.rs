@@ -237,3 +237,41 @@ fn lens_flags_blur_the_render_and_bad_values_are_located_errors() {
     assert!(err.contains(&format!("scene.toml:{line}:")), "{err}");
     assert!(err.contains("f-number -1 must be positive"), "{err}");
 }
+
+#[test]
+fn a_bare_obj_or_ply_renders_under_the_default_camera_and_sky() {
+    let dir = tempfile::tempdir().unwrap();
+    let obj = dir.path().join("quad.obj");
+    std::fs::write(&obj, "v -1 -1 0\nv 1 -1 0\nv 1 1 0\nv -1 1 0\nf 1 2 3 4\n").unwrap();
+    let ply = dir.path().join("quad.ply");
+    std::fs::write(
+        &ply,
+        "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\n\
+         property float z\nelement face 1\nproperty list uchar int vertex_indices\n\
+         end_header\n-1 -1 0\n1 -1 0\n1 1 0\n-1 1 0\n4 0 1 2 3\n",
+    )
+    .unwrap();
+    for model in [obj, ply] {
+        let out = dir.path().join("out.png");
+        let o = candela(&[
+            "render",
+            s(&model),
+            "-o",
+            s(&out),
+            "--res",
+            "16x16",
+            "--spp",
+            "2",
+        ]);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert!(o.status.success(), "{err}");
+        assert!(err.contains("white environment"), "{err}");
+        let img = image::open(&out).unwrap().to_rgb8();
+        // The grey model in the middle is darker than the white sky around it.
+        let (centre, corner) = (img.get_pixel(8, 8)[0], img.get_pixel(0, 0)[0]);
+        assert!(
+            centre < corner,
+            "{model:?}: centre {centre}, corner {corner}"
+        );
+    }
+}

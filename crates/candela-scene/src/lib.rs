@@ -37,6 +37,7 @@ pub mod environment;
 pub mod gltf;
 pub mod image_texture;
 pub mod limits;
+mod mesh_scene;
 pub mod obj;
 pub mod ply;
 mod toml_camera;
@@ -151,8 +152,8 @@ pub fn load_scene(path: &Path) -> Result<SceneDesc, LoadError> {
     load_scene_with(path, &LoadOptions::default()).map(|l| l.desc)
 }
 
-/// Loads a scene file (`.toml`, Mitsuba `.xml`, glTF `.gltf`/`.glb`), choosing the format
-/// by its extension.
+/// Loads a scene file (`.toml`, Mitsuba `.xml`, glTF `.gltf`/`.glb`, or a bare `.obj` or
+/// `.ply` mesh, see the `mesh_scene` module), choosing the format by its extension.
 pub fn load_scene_with(path: &Path, options: &LoadOptions) -> Result<LoadedScene, LoadError> {
     let file_span = || Span::new(path.display().to_string(), 1, 1);
     let ext = path
@@ -168,13 +169,17 @@ pub fn load_scene_with(path: &Path, options: &LoadOptions) -> Result<LoadedScene
         }
         "xml" => mitsuba::load_mitsuba(path, options),
         "gltf" | "glb" => crate::gltf::load_gltf(path, options),
+        "obj" | "ply" => mesh_scene::load_mesh_scene(path, &ext),
         "" => Err(LoadError::new(
             file_span(),
-            "scene file has no extension; expected .toml, .xml, .gltf or .glb",
+            "scene file has no extension; expected .toml, .xml, .gltf, .glb, .obj or .ply",
         )),
         other => Err(LoadError::new(
             file_span(),
-            format!("unsupported scene format \".{other}\"; supported: .toml, .xml, .gltf, .glb"),
+            format!(
+                "unsupported scene format \".{other}\"; supported: .toml, .xml, .gltf, .glb, \
+                 .obj, .ply"
+            ),
         )),
     }
 }

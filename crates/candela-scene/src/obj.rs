@@ -1,6 +1,8 @@
 //! Wavefront OBJ meshes through `tobj`: polygons triangulated as fans, one index per
 //! vertex (positions, normals and uvs deduplicated together), all objects and groups of
-//! the file merged into one mesh. Materials (`mtllib`) are ignored: the scene assigns one.
+//! the file merged into one mesh. As a shape of a scene its materials (`mtllib`) are
+//! ignored: the scene assigns one. Rendered alone ([`load_obj_parts`]), its faces are
+//! split by material.
 
 use std::fs::File;
 use std::io::{self, BufRead, BufReader, Read};
@@ -18,23 +20,84 @@ pub fn load_obj(path: &Path) -> Result<MeshDesc, MeshError> {
     parse_obj(BufReader::new(file), path)
 }
 
-/// Parses OBJ text; `path` names the file in errors.
+/// Parses OBJ text; `path` names the file in errors. `mtllib`s are not read.
 pub fn parse_obj(reader: impl BufRead, path: &Path) -> Result<MeshDesc, MeshError> {
+    let (models, _) = read_models(reader, path, |_| Err(tobj::LoadError::OpenFileFailed))?;
+    merge(&models.iter().collect::<Vec<_>>(), path)
+}
+
+/// An OBJ file as parts of a scene: one mesh for each material its faces use (`None`:
+/// faces under no `usemtl`), the materials of its `mtllib`s (read relative to the OBJ
+/// file), and why they could not be read if they could not.
+pub struct ObjParts {
+    pub meshes: Vec<(Option<usize>, MeshDesc)>,
+    pub materials: Vec<tobj::Material>,
+    pub mtl_error: Option<String>,
+}
+
+/// Loads an OBJ file with its materials (see [`ObjParts`]).
+pub fn load_obj_parts(path: &Path) -> Result<ObjParts, MeshError> {
+    let file =
+        File::open(path).map_err(|e| MeshError::new(path, None, format!("cannot open: {e}")))?;
+    let dir = path.parent().unwrap_or(Path::new("."));
+    let (models, materials) = read_models(BufReader::new(file), path, |mtl| {
+        tobj::load_mtl(dir.join(mtl))
+    })?;
+    let mut ids: Vec<Option<usize>> = models.iter().map(|m| m.mesh.material_id).collect();
+    ids.sort_unstable();
+    ids.dedup();
+    let mut meshes = Vec::new();
+    for id in ids {
+        let group: Vec<&tobj::Model> = models
+            .iter()
+            .filter(|m| m.mesh.material_id == id && !m.mesh.indices.is_empty())
+            .collect();
+        if !group.is_empty() {
+            meshes.push((id, merge(&group, path)?));
+        }
+    }
+    if meshes.is_empty() {
+        return Err(MeshError::new(path, None, "OBJ file has no faces"));
+    }
+    let (materials, mtl_error) = match materials {
+        Ok(m) => (m, None),
+        Err(e) => (Vec::new(), Some(e.to_string())),
+    };
+    Ok(ObjParts {
+        meshes,
+        materials,
+        mtl_error,
+    })
+}
+
+/// An OBJ file's models, and its materials or why they could not be read.
+type Models = (
+    Vec<tobj::Model>,
+    Result<Vec<tobj::Material>, tobj::LoadError>,
+);
+
+/// The models of an OBJ file, polygons triangulated, and its materials as `mtl` loads
+/// each `mtllib`.
+fn read_models(
+    reader: impl BufRead,
+    path: &Path,
+    mtl: impl Fn(&Path) -> tobj::MTLLoadResult,
+) -> Result<Models, MeshError> {
     let options = tobj::LoadOptions {
         triangulate: true,
         single_index: true,
         ..Default::default()
     };
     let mut reader = LineCounter::new(reader);
-    let (models, _materials) = tobj::load_obj_buf(&mut reader, &options, |_| {
-        Err(tobj::LoadError::OpenFileFailed)
-    })
-    .map_err(|e| {
+    tobj::load_obj_buf(&mut reader, &options, mtl).map_err(|e| {
         let line = line_local(&e).then(|| reader.line());
         MeshError::new(path, line, e.to_string())
-    })?;
+    })
+}
 
-    // Normals and uvs survive only if every vertex of every object has them.
+/// The models as one mesh. Normals and uvs survive only if every vertex of every model
+/// has them.
+fn merge(models: &[&tobj::Model], path: &Path) -> Result<MeshDesc, MeshError> {
     let all_normals = models
         .iter()
         .all(|m| m.mesh.normals.len() == m.mesh.positions.len());
@@ -42,7 +105,7 @@ pub fn parse_obj(reader: impl BufRead, path: &Path) -> Result<MeshDesc, MeshErro
         .iter()
         .all(|m| m.mesh.texcoords.len() / 2 == m.mesh.positions.len() / 3);
     let mut mesh = MeshDesc::default();
-    for m in &models {
+    for m in models {
         let m = &m.mesh;
         let base = mesh.positions.len() as u32;
         mesh.positions

@@ -330,8 +330,15 @@ pub fn parse_gltf(
         }
         None => desc.camera = camera::framing_camera(&desc.shapes, desc.camera.fov_y_deg),
     }
+    light_if_unlit(&mut desc, file, &mut warnings);
+    Ok(LoadedScene { desc, warnings })
+}
+
+/// Gives a scene without lights or emitting shapes (a model file of `file`) a uniform
+/// white environment of strength 1, and says so.
+pub(crate) fn light_if_unlit(desc: &mut SceneDesc, file: &Path, warnings: &mut Vec<String>) {
     let emits = desc.shapes.iter().any(|s| s.emission.is_some());
-    if desc.lights.is_empty() && !emits {
+    if desc.lights.is_empty() && !emits && desc.environment.is_none() {
         warnings.push(format!(
             "{}: no lights: lit by a uniform white environment of strength 1 (--env chooses \
              another)",
@@ -342,7 +349,6 @@ pub fn parse_gltf(
             ..EnvironmentDesc::default()
         });
     }
-    Ok(LoadedScene { desc, warnings })
 }
 
 /// Loads a `.gltf` or `.glb` file (see [`parse_gltf`]).
