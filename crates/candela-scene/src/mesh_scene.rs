@@ -4,10 +4,11 @@
 //!
 //! Materials: a PLY mesh, and OBJ faces without a material, are grey diffuse (albedo 0.5,
 //! the TOML default). An OBJ's `mtllib` materials become diffuse materials of colour `Kd`
-//! (default 0.5) or texture `map_Kd` (sRGB, path relative to the OBJ file, as most
-//! exporters write it), emitting `Ke` where it is not black. The Phong terms (`Ks`, `Ns`,
-//! `illum`), transparency (`d`, `Tr`) and the other maps have no faithful counterpart and
-//! are named in a warning; a missing MTL file is a warning too, its faces grey.
+//! (default 0.5) or texture `map_Kd` (sRGB; path relative to the OBJ file, as most
+//! exporters write it, `\` read as `/`), emitting `Ke` where it is not black. The Phong
+//! terms (`Ks`, `Ns`, `illum`), transparency (`d`, `Tr`) and the other maps have no
+//! faithful counterpart and are named in a warning; a missing MTL file is a warning too,
+//! its faces grey.
 
 use std::path::Path;
 use std::sync::Arc;
@@ -67,7 +68,8 @@ pub(crate) fn load_mesh_scene(path: &Path, ext: &str) -> Result<LoadedScene, Loa
             };
             let albedo = match &m.diffuse_texture {
                 Some(t) => {
-                    let image = load_image(&dir.join(t), Encoding::Srgb)
+                    // Exporters on Windows write `textures\wood.png`.
+                    let image = load_image(&dir.join(t.replace('\\', "/")), Encoding::Srgb)
                         .map_err(|e| LoadError::new(span.clone(), e))?;
                     TextureDesc::Image(ImageTextureDesc::new(Arc::new(image)))
                 }

@@ -10,7 +10,9 @@ use glam::Vec3;
 fn load(files: &[(&str, &[u8])]) -> Result<LoadedScene, String> {
     let dir = tempfile::tempdir().unwrap();
     for (name, bytes) in files {
-        std::fs::write(dir.path().join(name), bytes).unwrap();
+        let path = dir.path().join(name);
+        std::fs::create_dir_all(path.parent().unwrap()).unwrap();
+        std::fs::write(path, bytes).unwrap();
     }
     load_scene_with(&dir.path().join(files[0].0), &LoadOptions::default())
         .map_err(|e| e.to_string())
@@ -42,7 +44,7 @@ Ns 50
 newmtl lamp
 Kd 0 0 0
 Ke 4 3 2
-map_Kd tex.png
+map_Kd maps\\tex.png
 ";
 
 fn png() -> Vec<u8> {
@@ -58,7 +60,7 @@ fn an_obj_with_materials_renders_as_its_own_scene() {
     let loaded = load(&[
         ("model.obj", OBJ.as_bytes()),
         ("m.mtl", MTL.as_bytes()),
-        ("tex.png", &png),
+        ("maps/tex.png", &png),
     ])
     .unwrap();
     let d = &loaded.desc;
@@ -77,7 +79,7 @@ fn an_obj_with_materials_renders_as_its_own_scene() {
         matches!(albedo(d, "(no material)"), TextureDesc::Constant(c) if *c == Vec3::splat(0.5))
     );
     assert!(matches!(albedo(d, "red"), TextureDesc::Constant(c) if *c == Vec3::new(0.8, 0.1, 0.1)));
-    // map_Kd wins over Kd, decoded from sRGB (white stays 1).
+    // map_Kd wins over Kd, found through a Windows path, decoded from sRGB (white stays 1).
     match albedo(d, "lamp") {
         TextureDesc::Image(t) => assert_eq!(t.image.pixels[0], Vec3::ONE),
         t => panic!("{t:?}"),
