@@ -83,19 +83,13 @@ pub(crate) fn sensor(ctx: &mut Ctx, node: &Node) -> Result<(), LoadError> {
     };
     // Candela does not clip. Mitsuba's defaults (0.01 and 10⁴) rarely cut anything; other
     // values may be meant to, so those are pointed out.
-    for (clip, default, side) in [
-        ("near_clip", 0.01, "nearer than"),
-        ("far_clip", 1e4, "beyond"),
+    let near = node.float("near_clip")?.filter(|&v| v > 0.01);
+    let far = node.float("far_clip")?.filter(|&v| v < 1e4);
+    for (clip, cut, side) in [
+        ("near_clip", near, "nearer than"),
+        ("far_clip", far, "beyond"),
     ] {
-        let Some(v) = node.float(clip)? else {
-            continue;
-        };
-        let cuts_more = if clip == "near_clip" {
-            v > default
-        } else {
-            v < default
-        };
-        if cuts_more {
+        if let Some(v) = cut {
             let p = node.prop(clip).expect("read just now");
             ctx.warn(
                 p,
