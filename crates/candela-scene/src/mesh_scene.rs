@@ -2,8 +2,8 @@
 //! camera and light of a glTF file that has neither (a three-quarter view framing the
 //! mesh, a uniform white sky), at Candela's default render settings.
 //!
-//! Materials: a PLY mesh, and OBJ faces without a material, are grey diffuse (albedo 0.5,
-//! the TOML default). An OBJ's `mtllib` materials become diffuse materials of colour `Kd`
+//! Materials: a PLY mesh is diffuse of its vertex colours, or grey (albedo 0.5, the TOML
+//! default) without them, as are OBJ faces without a material. An OBJ's `mtllib` materials become diffuse materials of colour `Kd`
 //! (default 0.5) or texture `map_Kd` (sRGB; path relative to the OBJ file, as most
 //! exporters write it, `\` read as `/`), emitting `Ke` where it is not black. The Phong
 //! terms (`Ks`, `Ns`, `illum`), transparency (`d`, `Tr`) and the other maps have no
@@ -47,7 +47,12 @@ pub(crate) fn load_mesh_scene(path: &Path, ext: &str) -> Result<LoadedScene, Loa
     };
     if ext == "ply" {
         let mesh = ply::load_ply(path).map_err(mesh_error)?;
-        desc.materials.push(grey());
+        // Vertex colours multiply the albedo: they are the colour.
+        let albedo = if mesh.colors.is_empty() { GREY } else { 1.0 };
+        desc.materials.push(MaterialDesc {
+            bsdf: diffuse(TextureDesc::Constant(Vec3::splat(albedo))),
+            ..grey()
+        });
         desc.shapes.push(shape(mesh, NO_MATERIAL, None, &span));
     } else {
         let parts = obj::load_obj_parts(path).map_err(mesh_error)?;

@@ -1,5 +1,6 @@
 //! Stanford PLY meshes (ascii and binary) through `ply-rs-bw`: a `vertex` element with
-//! `x y z`, optional `nx ny nz` and uvs (`u v`, `s t` or `texture_u texture_v`), and a
+//! `x y z`, optional `nx ny nz`, uvs (`u v`, `s t` or `texture_u texture_v`) and colours
+//! (`red green blue` or `r g b`; see [`color_channel`]), and a
 //! `face` element whose `vertex_indices` (or `vertex_index`) lists are triangulated as
 //! fans. Counts declared in the header are checked against the file size before anything
 //! is read, so a truncated or hostile file cannot ask for a huge allocation.
@@ -7,6 +8,7 @@
 use std::io::Cursor;
 use std::path::Path;
 
+use candela_core::color::srgb_decode;
 use candela_core::desc::MeshDesc;
 use glam::{Vec2, Vec3};
 use ply_rs_bw::parser::{ParseError, Parser, Reader};
@@ -65,6 +67,9 @@ pub fn parse_ply(bytes: &[u8], path: &Path) -> Result<MeshDesc, MeshError> {
     ]
     .into_iter()
     .find(|uv| has(uv));
+    let color_names = [["red", "green", "blue"], ["r", "g", "b"]]
+        .into_iter()
+        .find(|c| has(c));
 
     let payload = parser.read_payload(&mut reader, &header).map_err(|e| {
         let line = (header.encoding == Encoding::Ascii)
@@ -94,6 +99,13 @@ pub fn parse_ply(bytes: &[u8], path: &Path) -> Result<MeshDesc, MeshError> {
             mesh.uvs
                 .push(uv.ok_or_else(|| err(None, format!("vertex {i}: uvs must be numbers")))?);
         }
+        if let Some(names) = color_names {
+            let c = names.map(|n| v.get(n).and_then(color_channel));
+            let [Some(r), Some(g), Some(b)] = c else {
+                return Err(err(None, format!("vertex {i}: colours must be numbers")));
+            };
+            mesh.colors.push(Vec3::new(r, g, b));
+        }
     }
     let n = mesh.positions.len();
     for (f, face) in faces.iter().enumerate() {
@@ -122,6 +134,19 @@ pub fn parse_ply(bytes: &[u8], path: &Path) -> Result<MeshDesc, MeshError> {
         return Err(err(None, "PLY file has no faces".into()));
     }
     Ok(mesh)
+}
+
+/// A vertex colour channel as linear light: 8- and 16-bit integers are sRGB-encoded, as
+/// scanners and Blender write them (so decoded, as Candela's image textures are), floats
+/// are taken as linear values.
+fn color_channel(p: &Property) -> Option<f32> {
+    let encoded = |v: f32, max: f32| srgb_decode((v / max).clamp(0.0, 1.0));
+    match p {
+        Property::UChar(v) => Some(encoded(f32::from(*v), 255.0)),
+        Property::UShort(v) => Some(encoded(f32::from(*v), 65535.0)),
+        Property::Float(_) | Property::Double(_) => p.to_f32_lossy().map(|v| v.max(0.0)),
+        _ => None,
+    }
 }
 
 /// The parser's message on one line, without its own "Line N: " prefix.
@@ -292,6 +317,31 @@ mod tests {
             bytes.extend(u32b(i));
         }
         bytes
+    }
+
+    #[test]
+    fn vertex_colours_are_decoded_to_linear_light() {
+        let header = |ty: &str| {
+            format!(
+                "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n\
+                 property float z\nproperty {ty} red\nproperty {ty} green\nproperty {ty} blue\n\
+                 element face 1\nproperty list uchar int vertex_indices\nend_header\n"
+            )
+        };
+        // 8- and 16-bit colours are sRGB: 255 is 1, 128 (or 32896) is 0.2158.
+        let bytes = header("uchar") + "0 0 0 255 128 0\n1 0 0 0 0 0\n0 1 0 1 1 1\n3 0 1 2\n";
+        let mesh = parse(bytes.as_bytes()).unwrap();
+        assert!((mesh.colors[0] - Vec3::new(1.0, 0.215_861, 0.0)).length() < 1e-5);
+        assert_eq!(mesh.colors.len(), 3);
+        let bytes = header("ushort") + "0 0 0 65535 32896 0\n1 0 0 0 0 0\n0 1 0 1 1 1\n3 0 1 2\n";
+        let mesh = parse(bytes.as_bytes()).unwrap();
+        assert!((mesh.colors[0] - Vec3::new(1.0, 0.215_861, 0.0)).length() < 1e-5);
+        // Floats are linear already.
+        let bytes = header("float") + "0 0 0 0.25 0.5 1\n1 0 0 0 0 0\n0 1 0 1 1 1\n3 0 1 2\n";
+        let mesh = parse(bytes.as_bytes()).unwrap();
+        assert_eq!(mesh.colors[0], Vec3::new(0.25, 0.5, 1.0));
+        // Without colours there are none.
+        assert!(parse(ASCII_QUAD.as_bytes()).unwrap().colors.is_empty());
     }
 
     #[test]

@@ -1,6 +1,6 @@
 //! A bare `.obj` or `.ply` file as a scene: its faces split by MTL material, diffuse
-//! colours, textures and emission carried over, what is left out named in a warning, and
-//! the automatic camera and sky of a model without its own.
+//! colours, textures and emission carried over, what is left out named in a warning, a
+//! PLY's vertex colours, and the automatic camera and sky of a model without its own.
 
 use candela_core::desc::{BsdfDesc, GeometryDesc, SceneDesc, TextureDesc};
 use candela_scene::{load_scene_with, LoadOptions, LoadedScene};
@@ -122,6 +122,45 @@ fn a_ply_renders_grey_under_the_default_sky() {
     assert_eq!(loaded.desc.shapes.len(), 1);
     assert!(loaded.desc.environment.is_some());
     assert!(candela_core::build::build(&loaded.desc).is_ok());
+}
+
+/// A triangle with one red, one green and one blue vertex (8-bit).
+const COLOURED_PLY: &str = "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\n\
+    property float y\nproperty float z\nproperty uchar red\nproperty uchar green\n\
+    property uchar blue\nelement face 1\nproperty list uchar int vertex_indices\n\
+    end_header\n0 0 0 255 0 0\n1 0 0 0 255 0\n0 1 0 0 0 255\n3 0 1 2\n";
+
+fn mesh_colors(desc: &SceneDesc) -> &[Vec3] {
+    match &desc.shapes[0].geometry {
+        GeometryDesc::Mesh(m) => &m.colors,
+        g => panic!("{g:?}"),
+    }
+}
+
+#[test]
+fn a_plys_vertex_colours_are_its_colour_except_in_mitsuba_scenes() {
+    // Alone, the colours are the albedo (times 1).
+    let loaded = load(&[("tri.ply", COLOURED_PLY.as_bytes())]).unwrap();
+    let d = &loaded.desc;
+    assert_eq!(mesh_colors(d), [Vec3::X, Vec3::Y, Vec3::Z]);
+    assert!(matches!(albedo(d, "(no material)"), TextureDesc::Constant(c) if *c == Vec3::ONE));
+    // In a TOML scene they multiply the scene's material.
+    let toml = "[materials.m]\ntype = \"diffuse\"\n[[shape]]\ntype = \"mesh\"\n\
+                file = \"tri.ply\"\nmaterial = \"m\"\n";
+    let loaded = load(&[
+        ("scene.toml", toml.as_bytes()),
+        ("tri.ply", COLOURED_PLY.as_bytes()),
+    ])
+    .unwrap();
+    assert_eq!(mesh_colors(&loaded.desc).len(), 3);
+    // Mitsuba does not tint a BSDF by them, so neither does its importer.
+    let xml = r#"<scene version="3.0.0"><shape type="ply"><string name="filename" value="tri.ply"/></shape></scene>"#;
+    let loaded = load(&[
+        ("scene.xml", xml.as_bytes()),
+        ("tri.ply", COLOURED_PLY.as_bytes()),
+    ])
+    .unwrap();
+    assert!(mesh_colors(&loaded.desc).is_empty());
 }
 
 #[test]

@@ -123,6 +123,9 @@ fn shape_desc(ctx: &mut Ctx, node: &Node) -> Result<Option<ShapeDesc>, LoadError
                 None => {
                     let mut mesh = crate::load_mesh(&key.0)
                         .map_err(|e| node.error(format!("cannot load mesh: {e}")))?;
+                    // Mitsuba keeps a PLY's colours as an attribute that only a
+                    // `mesh_attribute` texture reads; they do not tint the BSDF.
+                    mesh.colors.clear();
                     if face_normals {
                         mesh.normals.clear();
                     } else if mesh.normals.is_empty() {
