@@ -52,25 +52,17 @@ impl Conductor {
         if self.is_delta() || wo.z <= 0.0 || wi.z <= 0.0 {
             return Vec3::ZERO;
         }
-        let wm = (wo + wi).normalize_or_zero();
-        if wm == Vec3::ZERO {
+        let Some((wm, dg)) = self.distrib.reflection(wo, wi) else {
             return Vec3::ZERO;
-        }
-        let d = self.distrib.d(wm);
-        let g = self.distrib.g(wo, wi);
-        self.fresnel.eval(wo.dot(wm)) * (d * g / (4.0 * wo.z * wi.z))
+        };
+        self.fresnel.eval(wo.dot(wm)) * dg
     }
 
     pub fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
         if self.is_delta() || wo.z <= 0.0 || wi.z <= 0.0 {
             return 0.0;
         }
-        let wm = (wo + wi).normalize_or_zero();
-        if wm == Vec3::ZERO {
-            return 0.0;
-        }
-        // Jacobian of the reflection map: dωm/dωi = 1/(4 |ωo·ωm|).
-        self.distrib.d_visible(wo, wm) / (4.0 * wo.dot(wm).abs())
+        self.distrib.reflection_pdf(wo, wi)
     }
 
     pub fn sample(&self, wo: Vec3, u: Vec2) -> Option<BsdfSample> {

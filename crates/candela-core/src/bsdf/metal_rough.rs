@@ -60,13 +60,11 @@ impl MetalRough {
         if wo.z <= 0.0 || wi.z <= 0.0 {
             return Vec3::ZERO;
         }
-        let wm = (wo + wi).normalize_or_zero();
-        if wm == Vec3::ZERO {
+        let Some((wm, dg)) = self.distrib.reflection(wo, wi) else {
             return Vec3::ZERO;
-        }
+        };
         let f0 = self.f0();
-        let f = fresnel_schlick(f0, wo.dot(wm));
-        let spec = f * (self.distrib.d(wm) * self.distrib.g(wo, wi) / (4.0 * wo.z * wi.z));
+        let spec = fresnel_schlick(f0, wo.dot(wm)) * dg;
         let transmit =
             (Vec3::ONE - fresnel_schlick(f0, wo.z)) * (Vec3::ONE - fresnel_schlick(f0, wi.z));
         spec + transmit * self.diffuse_color() * FRAC_1_PI
@@ -76,13 +74,8 @@ impl MetalRough {
         if wo.z <= 0.0 || wi.z <= 0.0 {
             return 0.0;
         }
-        let wm = (wo + wi).normalize_or_zero();
-        if wm == Vec3::ZERO {
-            return 0.0;
-        }
         let ps = self.specular_probability(wo.z);
-        let spec = self.distrib.d_visible(wo, wm) / (4.0 * wo.dot(wm).abs());
-        ps * spec + (1.0 - ps) * cosine_hemisphere_pdf(wi.z)
+        ps * self.distrib.reflection_pdf(wo, wi) + (1.0 - ps) * cosine_hemisphere_pdf(wi.z)
     }
 
     pub fn sample(&self, wo: Vec3, u_lobe: f32, u: Vec2) -> Option<BsdfSample> {

@@ -52,6 +52,28 @@ pub trait MicrofacetDistribution {
         1.0 / (1.0 + self.lambda(wo) + self.lambda(wi))
     }
 
+    /// D(ωm) G(ωo, ωi) / (4 cos θo cos θi) of a reflection pair, with its half vector
+    /// ωm = (ωo + ωi)/|ωo + ωi|: the Torrance–Sparrow BRDF but for its Fresnel factor,
+    /// which is the caller's (of ωo·ωm). `None` where ωo + ωi vanishes.
+    fn reflection(&self, wo: Vec3, wi: Vec3) -> Option<(Vec3, f32)> {
+        let wm = (wo + wi).normalize_or_zero();
+        if wm == Vec3::ZERO {
+            return None;
+        }
+        Some((wm, self.d(wm) * self.g(wo, wi) / (4.0 * wo.z * wi.z)))
+    }
+
+    /// Density of ωi = reflect(ωo, ωm) for ωm sampled by [`Self::sample_wm`] from ωo:
+    /// D_ω(ωm)/(4 |ωo·ωm|) at the half vector, 1/(4 |ωo·ωm|) being the reflection's
+    /// Jacobian dωm/dωi. 0 where ωo + ωi vanishes.
+    fn reflection_pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
+        let wm = (wo + wi).normalize_or_zero();
+        if wm == Vec3::ZERO {
+            return 0.0;
+        }
+        self.d_visible(wo, wm) / (4.0 * wo.dot(wm).abs())
+    }
+
     /// Density of visible normals from `w`: G₁(ω)/|cos θ| · D(ωm) · |ω·ωm| (Heitz 2014,
     /// eq. 38); back-facing normals are invisible. From below (`w.z < 0`) the surface is
     /// seen mirrored, as [`Self::sample_wm`] samples it: the density is that seen from

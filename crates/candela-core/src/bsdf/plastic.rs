@@ -117,21 +117,10 @@ impl Plastic {
 
     /// The rough coat's reflection: F(ωo·ωm) D(ωm) G(ωo, ωi) / (4 cos θo cos θi).
     fn coat_f(&self, wo: Vec3, wi: Vec3) -> f32 {
-        let wm = (wo + wi).normalize_or_zero();
-        if wm == Vec3::ZERO {
-            return 0.0;
+        match self.distrib.reflection(wo, wi) {
+            Some((wm, dg)) => fresnel_dielectric(wo.dot(wm), self.eta) * dg,
+            None => 0.0,
         }
-        let f = fresnel_dielectric(wo.dot(wm), self.eta);
-        f * self.distrib.d(wm) * self.distrib.g(wo, wi) / (4.0 * wo.z * wi.z)
-    }
-
-    /// Density of the rough coat's visible-normal sampling.
-    fn coat_pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
-        let wm = (wo + wi).normalize_or_zero();
-        if wm == Vec3::ZERO {
-            return 0.0;
-        }
-        self.distrib.d_visible(wo, wm) / (4.0 * wo.dot(wm).abs())
     }
 
     /// The non-delta part: the base, and a rough coat's reflection.
@@ -155,7 +144,7 @@ impl Plastic {
         if self.is_smooth() {
             return diffuse;
         }
-        diffuse + ps * self.coat_pdf(wo, wi)
+        diffuse + ps * self.distrib.reflection_pdf(wo, wi)
     }
 
     pub fn sample(&self, wo: Vec3, u_lobe: f32, u: Vec2) -> Option<BsdfSample> {
