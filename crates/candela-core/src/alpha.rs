@@ -21,7 +21,7 @@
 use glam::Vec2;
 
 use crate::geometry::{Ray, TriangleHit};
-use crate::sampler::mix64;
+use crate::sampler::hash_uniform;
 use crate::scene::{Prim, Scene};
 use crate::texture::Texture;
 
@@ -63,11 +63,10 @@ impl AlphaMask {
 /// A uniform number in [0, 1) fixed by the ray and the primitive (splitmix64 over their
 /// bits): the same ray meeting the same triangle always decides the same way.
 pub fn hit_uniform(ray: &Ray, mesh: u32, tri: u32) -> f32 {
-    let mut h = mix64(((mesh as u64) << 32) | tri as u64);
-    for v in [ray.o.x, ray.o.y, ray.o.z, ray.d.x, ray.d.y, ray.d.z] {
-        h = mix64(h ^ v.to_bits() as u64);
-    }
-    (h >> 40) as f32 / (1u64 << 24) as f32
+    hash_uniform(
+        ((mesh as u64) << 32) | tri as u64,
+        &[ray.o.x, ray.o.y, ray.o.z, ray.d.x, ray.d.y, ray.d.z],
+    )
 }
 
 impl Scene {

@@ -668,6 +668,23 @@ fn build_material(bsdf: &BsdfDesc, span: &Span) -> Result<Material, BuildError> 
         },
         BsdfDesc::OneSided(inner) => Material::OneSided(Box::new(build_material(inner, span)?)),
         BsdfDesc::Alpha { inner, .. } => build_material(inner, span)?,
+        BsdfDesc::Mix { weight, a, b } => {
+            for side in [a, b] {
+                if build_alpha(side, span)?.is_some() {
+                    return err(
+                        span,
+                        "an alpha mask inside a mix is not supported (put it around the mix)",
+                    );
+                }
+            }
+            let (a, b) = (build_material(a, span)?, build_material(b, span)?);
+            Material::Mix {
+                weight: build_texture(weight, span, "mix weight")?,
+                level: 1 + a.mix_level().max(b.mix_level()),
+                a: Box::new(a),
+                b: Box::new(b),
+            }
+        }
     })
 }
 

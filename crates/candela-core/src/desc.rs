@@ -225,6 +225,14 @@ pub enum BsdfDesc {
         alpha: AlphaDesc,
         inner: Box<BsdfDesc>,
     },
+    /// `a` where the weight is 0, `b` where it is 1, and (1 − w)·a + w·b between: the
+    /// weight is the texture's first channel, clamped to [0, 1]. Rendered by choosing one
+    /// of the two at each shading point (see [`crate::material::Material::Mix`]).
+    Mix {
+        weight: TextureDesc,
+        a: Box<BsdfDesc>,
+        b: Box<BsdfDesc>,
+    },
 }
 
 /// The microfacet distribution of a rough conductor or dielectric (ignored when smooth).

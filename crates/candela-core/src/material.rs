@@ -4,6 +4,7 @@ use glam::{Vec2, Vec3};
 
 use crate::bsdf::{Bsdf, Dielectric, Diffuse, Lobe, MetalRough, Plastic};
 use crate::math::Frame;
+use crate::sampler::hash_uniform;
 use crate::scene::SurfaceInteraction;
 pub use crate::texture::Texture;
 
@@ -42,6 +43,21 @@ pub enum Material {
     },
     /// Black from the back: see [`crate::desc::BsdfDesc::OneSided`].
     OneSided(Box<Material>),
+    /// `a` with probability 1 − w and `b` with probability w at each shading point, w the
+    /// weight texture's first channel clamped to [0, 1]. In expectation this is the BSDF
+    /// (1 − w)·f_a + w·f_b, so the estimator stays unbiased; it costs one of the two
+    /// lobes per hit rather than both (pbrt-v4's `MixMaterial` chooses the same way).
+    /// The number deciding is a hash of the hit point, so a render stays reproducible
+    /// and NEE and BSDF sampling at a vertex see the same lobe.
+    Mix {
+        weight: Texture,
+        a: Box<Material>,
+        b: Box<Material>,
+        /// 1 + the highest `level` among the mixes inside this one. It salts the hash, so
+        /// that a mix and any mix nested in it (whose levels are always lower) decide
+        /// independently at the same point.
+        level: u32,
+    },
 }
 
 impl Material {
@@ -101,6 +117,19 @@ impl Material {
                 one_sided: true,
                 ..inner.bsdf_at(si)
             },
+            Material::Mix {
+                weight,
+                a,
+                b,
+                level,
+            } => {
+                let w = weight.eval_scalar(si.uv).clamp(0.0, 1.0);
+                if hash_uniform(*level as u64, &si.p.to_array()) < w {
+                    b.bsdf_at(si)
+                } else {
+                    a.bsdf_at(si)
+                }
+            }
             // A Lambertian lobe looks the same in every frame around ns, so it skips
             // orthogonalizing the tangent (a square root and a division per hit).
             Material::Diffuse { .. } => Bsdf::new(si.ns, si.ng, self.lobe(si.uv, si.color)),
@@ -133,6 +162,16 @@ impl Material {
                 roughness.eval_scalar(uv),
             )),
             Material::NormalMap { inner, .. } | Material::OneSided(inner) => inner.lobe(uv, color),
+            Material::Mix { .. } => unreachable!("bsdf_at_general chooses a mix's side"),
+        }
+    }
+
+    /// The [`Material::Mix`] `level` of this material: 0 for one holding no mix.
+    pub fn mix_level(&self) -> u32 {
+        match self {
+            Material::Mix { level, .. } => *level,
+            Material::NormalMap { inner, .. } | Material::OneSided(inner) => inner.mix_level(),
+            _ => 0,
         }
     }
 }
@@ -212,5 +251,120 @@ mod one_sided_tests {
         assert_eq!(one.f(back, -wi), Vec3::ZERO);
         assert_eq!(one.pdf(back, -wi), 0.0);
         assert!(one.sample(back, 0.5, Vec2::splat(0.3)).is_none());
+    }
+}
+
+#[cfg(test)]
+mod mix_tests {
+    use super::*;
+
+    fn diffuse(albedo: f32) -> Material {
+        Material::Diffuse {
+            albedo: Texture::Constant(Vec3::splat(albedo)),
+        }
+    }
+
+    fn mix(weight: Texture, a: Material, b: Material) -> Material {
+        Material::Mix {
+            weight,
+            level: 1 + a.mix_level().max(b.mix_level()),
+            a: Box::new(a),
+            b: Box::new(b),
+        }
+    }
+
+    /// The albedo of the lobe `m` chooses at point `p` and texture coordinates `uv`.
+    fn chosen(m: &Material, p: Vec3, uv: Vec2) -> f32 {
+        let si = SurfaceInteraction {
+            p,
+            t: 1.0,
+            ng: Vec3::Z,
+            ns: Vec3::Z,
+            uv,
+            dpdu: Vec3::X,
+            bitangent_sign: 1.0,
+            color: Vec3::ONE,
+            material: MaterialId(0),
+            light: None,
+        };
+        match m.bsdf_at(&si).lobe {
+            Lobe::Diffuse(d) => d.albedo.x,
+            lobe => panic!("{lobe:?}"),
+        }
+    }
+
+    /// Points spread over a few metres, none repeated.
+    fn points(n: usize) -> impl Iterator<Item = Vec3> {
+        (0..n).map(|i| {
+            let t = i as f32;
+            Vec3::new(
+                t * 1.37e-3,
+                (t * 0.618_034).fract() * 3.0,
+                (t * 0.414_213).fract(),
+            )
+        })
+    }
+
+    #[test]
+    fn a_mix_chooses_its_second_material_with_the_weights_probability() {
+        // A mix of 0.3 around a mix of 0.6: the lobes' frequencies over 60 000 points
+        // against 0.7, 0.3·0.4 and 0.3·0.6, by chi-square with 2 degrees of freedom at
+        // α = 10⁻³ (13.82). The inner mix's choice would be fixed by the outer one's if
+        // both hashed the point alike (then 0.3·0.4 would never come up).
+        let m = mix(
+            Texture::Constant(Vec3::splat(0.3)),
+            diffuse(0.1),
+            mix(
+                Texture::Constant(Vec3::splat(0.6)),
+                diffuse(0.2),
+                diffuse(0.4),
+            ),
+        );
+        let n = 60_000;
+        let mut counts = [0f64; 3];
+        for p in points(n) {
+            let albedo = chosen(&m, p, Vec2::ZERO);
+            assert_eq!(
+                albedo,
+                chosen(&m, p, Vec2::ZERO),
+                "the same point, the same lobe"
+            );
+            counts[[0.1, 0.2, 0.4].iter().position(|&a| a == albedo).unwrap()] += 1.0;
+        }
+        let expected = [0.7, 0.12, 0.18].map(|q| q * n as f64);
+        let chi2: f64 = (0..3)
+            .map(|k| (counts[k] - expected[k]).powi(2) / expected[k])
+            .sum();
+        eprintln!("mix frequencies {counts:?} against {expected:?}: chi2 {chi2:.2}");
+        assert!(chi2 < 13.82, "chi2 {chi2}: {counts:?} against {expected:?}");
+    }
+
+    #[test]
+    fn a_mix_weight_is_read_where_the_point_is_and_clamped_to_0_1() {
+        // A checker weight of 1.5 and −0.5: the second material on the squares above 1,
+        // the first on those below 0, at every point.
+        let m = mix(
+            Texture::Checker {
+                a: Vec3::splat(1.5),
+                b: Vec3::splat(-0.5),
+                uv_transform: glam::Affine2::IDENTITY,
+            },
+            diffuse(0.1),
+            diffuse(0.2),
+        );
+        let a_square = Texture::Checker {
+            a: Vec3::ONE,
+            b: Vec3::ZERO,
+            uv_transform: glam::Affine2::IDENTITY,
+        };
+        for (i, p) in points(2000).enumerate() {
+            let uv = Vec2::new((i % 37) as f32 / 37.0, (i % 53) as f32 / 53.0) * 4.0;
+            let expected = if a_square.eval_scalar(uv) == 1.0 {
+                0.2
+            } else {
+                0.1
+            };
+            assert_eq!(chosen(&m, p, uv), expected, "uv {uv}");
+        }
     }
 }

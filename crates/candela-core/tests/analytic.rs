@@ -180,6 +180,49 @@ fn closed_emitting_sphere_has_radiance_le_over_one_minus_albedo() {
 }
 
 #[test]
+fn a_closed_sphere_of_a_mixed_material_reflects_the_mixed_albedo() {
+    // The closed emitting sphere again, its wall a mix: of weight w between diffuse ρ_a
+    // and ρ_b, or between diffuse ρ_a and a perfect mirror (Mitsuba's `none` conductor,
+    // η = 0, k = 1, albedo 1 at every angle). Under the uniform radiance L inside, the
+    // wall reflects L·((1 − w)·ρ_a + w·ρ_b) towards every direction, so L = Le/(1 − ρ)
+    // with that ρ, exactly as for a plain wall. This checks that choosing one side per
+    // hit leaves the estimator unbiased under every MIS mode, a delta side included
+    // (where next event estimation is skipped for the hit).
+    let diffuse = |albedo: f32| BsdfDesc::Diffuse {
+        albedo: TextureDesc::Constant(Vec3::splat(albedo)),
+    };
+    let mirror = BsdfDesc::Conductor {
+        eta: Vec3::ZERO,
+        k: Vec3::ONE,
+        specular: Vec3::ONE,
+        alpha_u: 0.0,
+        alpha_v: 0.0,
+        distribution: MicrofacetDesc::Ggx,
+    };
+    let le = 0.7;
+    for (name, b, rho_b, w) in [
+        ("diffuse 0.2 + 0.9", diffuse(0.9), 0.9, 0.4f32),
+        ("diffuse 0.2 + mirror", mirror, 1.0, 0.3),
+    ] {
+        let rho = (1.0 - w as f64) * 0.2 + w as f64 * rho_b;
+        for (sampler, mis) in SAMPLERS.into_iter().flat_map(|s| MIS_MODES.map(|m| (s, m))) {
+            let mut desc = closed_sphere(0.0, le, settings(sampler, mis, 1000, 64, 29));
+            desc.materials[0].bsdf = BsdfDesc::Mix {
+                weight: TextureDesc::Constant(Vec3::splat(w)),
+                a: Box::new(diffuse(0.2)),
+                b: Box::new(b.clone()),
+            };
+            check_uniform(
+                &format!("mixed sphere {name} at w {w}, {mis:?}, {sampler:?}"),
+                &render_pixels(&desc),
+                le as f64 / (1.0 - rho),
+                true,
+            );
+        }
+    }
+}
+
+#[test]
 fn russian_roulette_starts_after_rr_depth_bounces() {
     // The closed ρ = 0.5 sphere again, cut at max_depth 4: L = Le·(1 + ρ + … + ρ⁴) whether
     // or not roulette runs. With BSDF sampling only a path casts one ray a segment, and

@@ -24,6 +24,7 @@ pub(crate) const MATERIAL_TYPES: &[&str] = &[
     "dielectric",
     "plastic",
     "metal_rough",
+    "mix",
 ];
 
 /// A texturable value: one number, `[r, g, b]`, or a texture table.
@@ -137,6 +138,8 @@ struct MaterialEntry {
     distribution: Option<Distribution>,
     thin: Option<bool>,
     two_sided: Option<bool>,
+    materials: Option<Spanned<Vec<Spanned<String>>>>,
+    weight: Option<Spanned<TexValue>>,
 }
 
 /// Whether a texture slot holds colour (sRGB-decoded by default) or data (linear).
@@ -165,16 +168,19 @@ fn allowed_keys(kind: &str) -> &'static [&'static str] {
         "dielectric" => &["eta", "alpha", "alpha_u", "alpha_v", "distribution", "thin"],
         "plastic" => &["albedo", "eta", "alpha", "distribution"],
         "metal_rough" => &["base_color", "metallic", "roughness"],
+        "mix" => &["materials", "weight"],
         _ => &[],
     }
 }
 
-/// Parses one material of the given (already checked) type.
+/// Parses one material of the given (already checked) type; `mixed` gives the BSDF of a
+/// material a mix names.
 pub(crate) fn parse_material(
     src: &Source,
     base: &Path,
     kind: &str,
     item: Item,
+    mixed: &mut dyn FnMut(&Spanned<String>) -> Result<BsdfDesc, LoadError>,
 ) -> Result<BsdfDesc, LoadError> {
     // Reject keys of other types first, so the error names the key.
     if let Some(table) = item.get_ref().as_table() {
@@ -261,6 +267,28 @@ pub(crate) fn parse_material(
             metallic: tex(m.metallic, Vec3::ONE, Slot::Data)?,
             roughness: tex(m.roughness, Vec3::ONE, Slot::Data)?,
         },
+        "mix" => {
+            let Some(names) = m.materials else {
+                return Err(src.error(at, "a mix needs `materials = [\"A\", \"B\"]`"));
+            };
+            let [a, b] = names.get_ref().as_slice() else {
+                return Err(src.error(
+                    names.span().start,
+                    format!("a mix takes 2 materials, not {}", names.get_ref().len()),
+                ));
+            };
+            let Some(weight) = m.weight else {
+                return Err(src.error(
+                    at,
+                    "a mix needs a `weight` (0 gives the first material, 1 the second)",
+                ));
+            };
+            BsdfDesc::Mix {
+                weight: texture(src, base, weight, Slot::Data)?,
+                a: Box::new(mixed(a)?),
+                b: Box::new(mixed(b)?),
+            }
+        }
         other => unreachable!("type {other} was checked"),
     };
     let bsdf = match m.normal_map {

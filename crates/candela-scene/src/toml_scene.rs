@@ -11,8 +11,8 @@
 use std::path::Path;
 
 use candela_core::desc::{
-    EmissionProfileDesc, LightSamplerKind, MaterialDesc, MisMode, RenderSettings, SamplerKind,
-    SceneDesc,
+    BsdfDesc, EmissionProfileDesc, LightSamplerKind, MaterialDesc, MisMode, RenderSettings,
+    SamplerKind, SceneDesc,
 };
 use serde::de::DeserializeOwned;
 use serde::Deserialize;
@@ -210,16 +210,81 @@ fn parse_materials(src: &Source, base: &Path, value: Item) -> Result<Vec<Materia
     let DeValue::Table(table) = value.into_inner() else {
         return Err(src.error(at, "`materials` must be a table of named materials"));
     };
-    let mut out = Vec::new();
+    let mut entries = Vec::new();
     for (name, item) in table {
-        let span = src.span(name.span().start);
         let kind = item_type(src, "material", &item, MATERIAL_TYPES)?;
-        let bsdf = parse_material(src, base, kind, item)?;
-        out.push(MaterialDesc {
-            name: name.into_inner().into_owned(),
-            bsdf,
-            span,
+        entries.push(MaterialEntry {
+            name: name.get_ref().to_string(),
+            at: name.span().start,
+            kind,
+            item: Some(item),
+            bsdf: None,
         });
     }
-    Ok(out)
+    for i in 0..entries.len() {
+        parse_entry(src, base, &mut entries, i, 0)?;
+    }
+    Ok(entries
+        .into_iter()
+        .map(|e| MaterialDesc {
+            span: src.span(e.at),
+            name: e.name,
+            bsdf: e.bsdf.expect("every entry was parsed"),
+        })
+        .collect())
+}
+
+/// A `[materials.NAME]` entry: its item until it is parsed, then its BSDF.
+struct MaterialEntry<'i> {
+    name: String,
+    at: usize,
+    kind: &'static str,
+    item: Option<Item<'i>>,
+    bsdf: Option<BsdfDesc>,
+}
+
+/// How deep mixes may nest (each level is a recursion when the scene is read and at every
+/// hit on it).
+const MAX_MIX_DEPTH: usize = 16;
+
+/// Parses entry `i` (once), and first the materials it mixes, whatever their order in
+/// the file, `depth` mixes down; a mix that contains itself is an error at the name
+/// closing the loop.
+fn parse_entry(
+    src: &Source,
+    base: &Path,
+    entries: &mut [MaterialEntry],
+    i: usize,
+    depth: usize,
+) -> Result<BsdfDesc, LoadError> {
+    if let Some(bsdf) = &entries[i].bsdf {
+        return Ok(bsdf.clone());
+    }
+    let Some(item) = entries[i].item.take() else {
+        unreachable!("a mix's loop is caught before its entry is parsed again")
+    };
+    let kind = entries[i].kind;
+    let bsdf = parse_material(src, base, kind, item, &mut |name| {
+        let Some(j) = entries.iter().position(|e| e.name == *name.get_ref()) else {
+            return Err(src.error(
+                name.span().start,
+                format!("unknown material \"{}\" in a mix", name.get_ref()),
+            ));
+        };
+        if entries[j].bsdf.is_none() && entries[j].item.is_none() {
+            return Err(src.error(
+                name.span().start,
+                format!("material \"{}\" mixes itself", name.get_ref()),
+            ));
+        }
+        if depth == MAX_MIX_DEPTH {
+            return Err(src.error(
+                name.span().start,
+                format!("mixes nest more than {MAX_MIX_DEPTH} deep here"),
+            ));
+        }
+        parse_entry(src, base, entries, j, depth + 1)
+    })?;
+    entries[i].bsdf = Some(bsdf.clone());
+    Ok(bsdf)
 }

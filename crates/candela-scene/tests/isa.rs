@@ -46,13 +46,14 @@ fn film_bits(file: &str, isa: Isa) -> (Vec<u64>, u64) {
     (bits, result.stats.rays)
 }
 
-const SCENES: [&str; 11] = [
+const SCENES: [&str; 12] = [
     "cornell.toml",
     "glass_sphere.toml",
     "rough_metals.toml",
     "microfacets.toml",
     "plastics.toml",
     "isometric.toml",
+    "mix.toml",
     "dof.toml",
     "ies-room.toml",
     "environment.toml",

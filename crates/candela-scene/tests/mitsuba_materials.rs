@@ -889,6 +889,152 @@ fn masks_become_stochastic_alpha_and_normalmaps_get_mitsubas_bitangent() {
 }
 
 #[test]
+fn blendbsdfs_become_mixes_of_their_two_bsdfs_in_order() {
+    let mix = |b: BsdfDesc| match b {
+        BsdfDesc::Mix { weight, a, b } => (weight, *a, *b),
+        b => panic!("{b:?}"),
+    };
+    let one_sided = |b: &BsdfDesc| match b {
+        BsdfDesc::OneSided(inner) => inner.as_ref().clone(),
+        b => panic!("{b:?}"),
+    };
+    // Weight 0 is the first BSDF, 1 the second; each keeps its own (one-)sidedness, as
+    // in Mitsuba, where the blend of two one-sided BSDFs is black from the back.
+    let (w, a, b) = mix(bsdf(
+        r#"<bsdf type="blendbsdf"><float name="weight" value="0.3"/>
+           <bsdf type="diffuse"/><bsdf type="conductor"/></bsdf>"#,
+    ));
+    assert!(matches!(w, TextureDesc::Constant(c) if c == Vec3::splat(0.3)));
+    assert!(matches!(one_sided(&a), BsdfDesc::Diffuse { .. }), "{a:?}");
+    assert!(matches!(one_sided(&b), BsdfDesc::Conductor { .. }), "{b:?}");
+    // Inside a twosided both are two-sided.
+    let (_, a, b) = mix(bsdf(
+        r#"<bsdf type="twosided"><bsdf type="blendbsdf"><float name="weight" value="0.3"/>
+           <bsdf type="diffuse"/><bsdf type="plastic"/></bsdf></bsdf>"#,
+    ));
+    assert!(matches!(a, BsdfDesc::Diffuse { .. }), "{a:?}");
+    assert!(matches!(b, BsdfDesc::Plastic { .. }), "{b:?}");
+    // References, in their order; an RGB weight is its mean (Mitsuba 3.9.1, scalar_rgb:
+    // a blend of white and black diffuse with weight (0.2, 0.5, 0.9) evaluates to
+    // 0.46667/π towards the normal, so w = 0.53333).
+    let desc = load(
+        r#"<bsdf type="diffuse" id="d"/><bsdf type="roughconductor" id="c"/>
+           <bsdf type="blendbsdf" id="m"><rgb name="weight" value="0.2, 0.5, 0.9"/>
+             <ref id="c"/><ref id="d"/></bsdf>
+           <shape type="cube"><ref id="m"/></shape>"#,
+    )
+    .desc;
+    let m = desc.materials.iter().find(|m| m.name == "m").unwrap();
+    let (w, a, b) = mix(m.bsdf.clone());
+    assert!(
+        matches!(w, TextureDesc::Constant(c) if (c - Vec3::splat(0.533_333)).abs().max_element() < 1e-6)
+    );
+    assert!(matches!(one_sided(&a), BsdfDesc::Conductor { .. }), "{a:?}");
+    assert!(matches!(one_sided(&b), BsdfDesc::Diffuse { .. }), "{b:?}");
+    build(&desc).expect("a blend builds");
+}
+
+#[test]
+fn blend_weights_and_mask_opacities_read_a_bitmap_as_its_luminance() {
+    // Mitsuba reads a scalar parameter's bitmap through `eval_1`, the luminance of its
+    // colour (3.9.1: a blend weight and a mask opacity of (0.2, 0.5, 0.9) both evaluate
+    // to 0.46507, the Rec. 709 Y 0.4651). An inline colour is its mean (0.53333).
+    let png = png_2x2();
+    let srgb_128 = 0.215_861f32;
+    let y = |c: Vec3| c.dot(Vec3::new(0.2126, 0.7152, 0.0722));
+    for (wrapper, slot) in [("blendbsdf", "weight"), ("mask", "opacity")] {
+        let second = if wrapper == "blendbsdf" {
+            "<bsdf type=\"conductor\"/>"
+        } else {
+            ""
+        };
+        let x = scene(&format!(
+            r#"<shape type="rectangle"><bsdf type="{wrapper}">
+                 <texture type="bitmap" name="{slot}"><string name="filename" value="t.png"/></texture>
+                 <bsdf type="diffuse"/>{second}</bsdf></shape>"#
+        ));
+        let loaded = load_files(&[("scene.xml", x.as_bytes()), ("t.png", &png)], false).unwrap();
+        let texture = match &loaded.desc.materials[0].bsdf {
+            BsdfDesc::Mix { weight, .. } => weight.clone(),
+            BsdfDesc::Alpha { alpha, .. } => alpha.texture.clone().unwrap(),
+            b => panic!("{b:?}"),
+        };
+        let t = build_texture(&texture, &Span::code(), slot).unwrap();
+        // The top-left texel (red) and the middle (the mean of all four).
+        for (uv, rgb) in [
+            (Vec2::new(0.25, 0.25), Vec3::new(srgb_128, 0.0, 0.0)),
+            (Vec2::new(0.5, 0.5), Vec3::splat(srgb_128 / 2.0)),
+        ] {
+            assert_close(t.eval(uv), Vec3::splat(y(rgb)), 1e-6);
+        }
+    }
+    let (a, _) = match bsdf(
+        r#"<bsdf type="mask"><rgb name="opacity" value="0.2, 0.5, 0.9"/><bsdf type="diffuse"/></bsdf>"#,
+    ) {
+        BsdfDesc::Alpha { alpha, inner } => (alpha, inner),
+        b => panic!("{b:?}"),
+    };
+    assert!(
+        (a.factor - 0.533_333).abs() < 1e-6 && a.texture.is_none(),
+        "{a:?}"
+    );
+
+    // A checkerboard's squares swap: Mitsuba 3.9.1's checkerboard (color0 0.9, color1
+    // 0.15, `to_uv` scale 4) evaluates at uv (0.05, 0.05) to 0.9 through `eval` (as a
+    // reflectance) but to 0.15 through `eval_1` (as a weight).
+    let checker = r#"<texture type="checkerboard" name="NAME"><float name="color0" value="0.9"/>
+          <float name="color1" value="0.15"/><transform name="to_uv"><scale value="4"/></transform></texture>"#;
+    let at = |t: &TextureDesc| {
+        build_texture(t, &Span::code(), "checker")
+            .unwrap()
+            .eval(Vec2::splat(0.05))
+            .x
+    };
+    let BsdfDesc::Mix { weight, a, .. } = bsdf(&format!(
+        r#"<bsdf type="blendbsdf">{}<bsdf type="diffuse">{}</bsdf><bsdf type="diffuse"/></bsdf>"#,
+        checker.replace("NAME", "weight"),
+        checker.replace("NAME", "reflectance")
+    )) else {
+        panic!()
+    };
+    let BsdfDesc::OneSided(a) = *a else {
+        panic!("{a:?}")
+    };
+    let BsdfDesc::Diffuse { albedo } = *a else {
+        panic!("{a:?}")
+    };
+    assert_eq!((at(&albedo), at(&weight)), (0.9, 0.15));
+}
+
+#[test]
+fn a_blendbsdf_without_a_weight_or_two_bsdfs_is_an_error_at_its_place() {
+    for (body, what) in [
+        (
+            r#"<shape type="cube"><bsdf type="blendbsdf"><bsdf type="diffuse"/><bsdf type="diffuse"/></bsdf></shape>"#,
+            "scene.xml:2:20: blendbsdf needs a `weight`",
+        ),
+        (
+            r#"<shape type="cube"><bsdf type="blendbsdf"><float name="weight" value="0.5"/><bsdf type="diffuse"/></bsdf></shape>"#,
+            "scene.xml:2:20: blendbsdf needs exactly two nested <bsdf> or <ref>, not 1",
+        ),
+    ] {
+        let e = load_err(body);
+        assert!(e.contains(what), "{e}");
+    }
+    // A mask belongs around the blend: inside it, it would have to blend coverage.
+    let desc = load(
+        r#"<shape type="cube"><bsdf type="blendbsdf"><float name="weight" value="0.5"/>
+             <bsdf type="mask"><bsdf type="diffuse"/></bsdf><bsdf type="diffuse"/></bsdf></shape>"#,
+    )
+    .desc;
+    let e = build(&desc).map(|_| ()).unwrap_err().to_string();
+    assert!(
+        e.contains("an alpha mask inside a mix is not supported"),
+        "{e}"
+    );
+}
+
+#[test]
 fn unknown_plugins_name_themselves() {
     for (body, what) in [
         (

@@ -190,3 +190,106 @@ fn built_scene_rejects_bad_numbers() {
         "{e}"
     );
 }
+
+#[test]
+fn a_mix_names_two_materials_defined_anywhere_in_the_table() {
+    // The mix comes before the materials it names, and one side is itself a mix.
+    let text = r#"
+[materials.worn]
+type = "mix"
+materials = ["paint", "patina"]
+weight = { type = "checker", a = 0.25, b = 0.75 }
+normal_map = [0.5, 0.5, 1]
+
+[materials.paint]
+type = "plastic"
+albedo = [0.8, 0.1, 0.1]
+
+[materials.patina]
+type = "mix"
+materials = ["gold", "rust"]
+weight = 0.5
+
+[materials.gold]
+type = "conductor"
+preset = "Au"
+
+[materials.rust]
+type = "diffuse"
+albedo = [0.3, 0.1, 0.05]
+"#;
+    let desc = parse_toml_scene(text, Path::new("scene.toml")).unwrap();
+    let worn = &desc
+        .materials
+        .iter()
+        .find(|m| m.name == "worn")
+        .unwrap()
+        .bsdf;
+    let BsdfDesc::NormalMap { inner, .. } = worn else {
+        panic!("{worn:?}")
+    };
+    let BsdfDesc::Mix { weight, a, b } = inner.as_ref() else {
+        panic!("{inner:?}")
+    };
+    assert!(matches!(weight, TextureDesc::Checker { a, b, .. }
+        if *a == Vec3::splat(0.25) && *b == Vec3::splat(0.75)));
+    assert!(matches!(a.as_ref(), BsdfDesc::Plastic { .. }), "{a:?}");
+    let BsdfDesc::Mix { weight, a, b } = b.as_ref() else {
+        panic!("{b:?}")
+    };
+    assert!(matches!(weight, TextureDesc::Constant(c) if *c == Vec3::splat(0.5)));
+    assert!(matches!(a.as_ref(), BsdfDesc::Conductor { .. }), "{a:?}");
+    assert!(matches!(b.as_ref(), BsdfDesc::Diffuse { .. }), "{b:?}");
+    candela_core::build::build(&desc).expect("the mixes build");
+}
+
+#[test]
+fn a_mix_without_its_materials_or_weight_or_in_a_loop_is_an_error_at_its_place() {
+    let cases = [
+        (
+            "[materials.m]\ntype = \"mix\"\nweight = 0.5\n",
+            "scene.toml:1:1: a mix needs `materials",
+        ),
+        (
+            "[materials.m]\ntype = \"mix\"\nmaterials = [\"a\"]\nweight = 0.5\n",
+            "scene.toml:3:13: a mix takes 2 materials, not 1",
+        ),
+        (
+            "[materials.a]\ntype = \"diffuse\"\n[materials.m]\ntype = \"mix\"\nmaterials = [\"a\", \"a\"]\n",
+            "scene.toml:3:1: a mix needs a `weight`",
+        ),
+        (
+            "[materials.a]\ntype = \"diffuse\"\n[materials.m]\ntype = \"mix\"\nmaterials = [\"a\", \"b\"]\nweight = 1\n",
+            "scene.toml:5:19: unknown material \"b\" in a mix",
+        ),
+        (
+            "[materials.m]\ntype = \"mix\"\nmaterials = [\"n\", \"n\"]\nweight = 1\n\
+             [materials.n]\ntype = \"mix\"\nmaterials = [\"m\", \"m\"]\nweight = 0\n",
+            "scene.toml:7:14: material \"m\" mixes itself",
+        ),
+        (
+            "[materials.m]\ntype = \"mix\"\nmaterials = [\"m\", \"m\"]\nweight = 1\n",
+            "scene.toml:3:14: material \"m\" mixes itself",
+        ),
+        (
+            "[materials.m]\ntype = \"mix\"\nalbedo = 0.5\n",
+            "scene.toml:3:1: unknown key `albedo` for a mix material",
+        ),
+    ];
+    // A chain of 20 mixes, each naming the next.
+    let chain: String = (0..20)
+        .map(|i| format!("[materials.m{i:02}]\ntype = \"mix\"\nmaterials = [\"m{:02}\", \"d\"]\nweight = 0.5\n", i + 1))
+        .chain(["[materials.m20]\ntype = \"diffuse\"\n[materials.d]\ntype = \"diffuse\"\n".into()])
+        .collect();
+    let e = parse_toml_scene(&chain, Path::new("scene.toml"))
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("mixes nest more than 16 deep here"), "{e}");
+    for (text, expected) in cases {
+        let e = parse_toml_scene(text, Path::new("scene.toml"))
+            .unwrap_err()
+            .to_string();
+        eprintln!("{e}");
+        assert!(e.starts_with(expected), "{text}\n→ {e}");
+    }
+}

@@ -149,6 +149,16 @@ pub fn mix64(mut v: u64) -> u64 {
     v ^ (v >> 31)
 }
 
+/// A uniform number in [0, 1) fixed by a key and some floats (splitmix64 over their
+/// bits): the same inputs always give the same number.
+pub fn hash_uniform(key: u64, values: &[f32]) -> f32 {
+    let mut h = mix64(key);
+    for v in values {
+        h = mix64(h ^ v.to_bits() as u64);
+    }
+    (h >> 40) as f32 / (1u64 << 24) as f32
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -5,7 +5,9 @@
 use candela_core::alpha::AlphaMode;
 
 use candela_core::bsdf::metal_preset;
-use candela_core::desc::{AlphaDesc, BsdfDesc, MaterialDesc, MicrofacetDesc, TextureDesc};
+use candela_core::desc::{
+    AlphaDesc, BsdfDesc, ImageDesc, MaterialDesc, MicrofacetDesc, TextureDesc,
+};
 use glam::Vec3;
 
 use super::parse::Node;
@@ -77,7 +79,7 @@ fn bsdf(ctx: &mut Ctx, node: &Node) -> Result<BsdfDesc, LoadError> {
         ctx.check_unused(node)?;
         return Ok(d);
     }
-    if matches!(node.kind(), "mask" | "normalmap") {
+    if matches!(node.kind(), "mask" | "normalmap" | "blendbsdf") {
         return wrapper(ctx, node, false);
     }
     Ok(match two_sided(ctx, node)? {
@@ -152,7 +154,7 @@ fn two_sided(ctx: &mut Ctx, node: &Node) -> Result<BsdfDesc, LoadError> {
                 linear: !node.boolean("nonlinear")?.unwrap_or(false),
             }
         }
-        "mask" | "normalmap" => return wrapper(ctx, node, true),
+        "mask" | "normalmap" | "blendbsdf" => return wrapper(ctx, node, true),
         "twosided" => return Err(node.error("twosided inside twosided")),
         _ => {
             ctx.unsupported(node, format!("<{}> is not supported", describe(node)))?;
@@ -164,82 +166,141 @@ fn two_sided(ctx: &mut Ctx, node: &Node) -> Result<BsdfDesc, LoadError> {
     Ok(d)
 }
 
-/// `mask` and `normalmap`, which wrap one nested BSDF or a `<ref>` to one (two-sided
-/// where the wrapper sits in a `twosided`, so that it keeps the sidedness of its place).
+/// `mask`, `normalmap` and `blendbsdf`, which wrap nested BSDFs or `<ref>`s to them
+/// (two-sided where the wrapper sits in a `twosided`, so that they keep the sidedness of
+/// their place).
 ///
 /// - `mask`: Mitsuba's opacity α (default 0.5) lets a ray pass with probability 1 − α,
-///   which is Candela's stochastic alpha ([`AlphaMode::Blend`]); a texture's first
-///   channel is read.
+///   which is Candela's stochastic alpha ([`AlphaMode::Blend`]).
 /// - `normalmap`: Mitsuba's shading normal 2·rgb − 1 in the frame of ∂p/∂u and n × ∂p/∂u,
 ///   Candela's tangent-space normal map (x along +u, y along +v) on the same uvs.
+/// - `blendbsdf`: (1 − w)·first + w·second, Candela's [`BsdfDesc::Mix`].
+///
+/// Mask opacity and blend weight are read as Mitsuba's `eval_1` reads a texture: see
+/// [`scalar`].
 fn wrapper(ctx: &mut Ctx, node: &Node, in_two_sided: bool) -> Result<BsdfDesc, LoadError> {
-    let nested: Vec<&Node> = node.plugins("bsdf").collect();
-    let inner_desc = match nested.as_slice() {
-        [one] => Some(*one),
-        [] => None,
-        _ => return Err(node.error(format!("{} needs exactly one nested <bsdf>", node.kind()))),
-    };
-    let inner = |ctx: &mut Ctx| -> Result<BsdfDesc, LoadError> {
-        match (inner_desc, in_two_sided) {
-            (Some(one), true) => return two_sided(ctx, one),
-            (Some(one), false) => return bsdf(ctx, one),
-            (None, _) => {}
+    let kind = node.kind();
+    let count = if kind == "blendbsdf" { 2 } else { 1 };
+    let mut inner = nested(ctx, node, in_two_sided)?;
+    if inner.len() != count {
+        let what = if count == 1 { "one" } else { "two" };
+        return Err(node.error(format!(
+            "{kind} needs exactly {what} nested <bsdf> or <ref>, not {}",
+            inner.len()
+        )));
+    }
+    let d = match kind {
+        "mask" => {
+            let alpha = match scalar(ctx.texture(node, "opacity", Vec3::splat(0.5))?) {
+                TextureDesc::Constant(c) => AlphaDesc {
+                    mode: AlphaMode::Blend,
+                    factor: c.x,
+                    texture: None,
+                },
+                t => AlphaDesc {
+                    mode: AlphaMode::Blend,
+                    factor: 1.0,
+                    texture: Some(t),
+                },
+            };
+            BsdfDesc::Alpha {
+                alpha,
+                inner: Box::new(inner.remove(0)),
+            }
         }
-        match referenced(ctx, node)? {
-            // Where the wrapper sits inside a twosided, so does what it refers to.
-            Some(BsdfDesc::OneSided(d)) if in_two_sided => Ok(*d),
-            Some(d) => Ok(d),
-            None => Err(node.error(format!(
-                "{} needs exactly one nested <bsdf> or a <ref>",
-                node.kind()
-            ))),
+        "normalmap" => {
+            if node.prop("normalmap").is_none() {
+                return Err(node.error("normalmap needs a <texture name=\"normalmap\">"));
+            }
+            BsdfDesc::NormalMap {
+                map: ctx.texture(node, "normalmap", Vec3::Z)?,
+                inner: Box::new(inner.remove(0)),
+            }
         }
-    };
-    let d = if node.kind() == "mask" {
-        let textured = node
-            .children
-            .iter()
-            .any(|c| c.name() == "opacity" && matches!(c.tag.as_str(), "texture" | "ref"));
-        let alpha = match textured {
-            true => AlphaDesc {
-                mode: AlphaMode::Blend,
-                factor: 1.0,
-                texture: Some(ctx.texture(node, "opacity", Vec3::ONE)?),
-            },
-            false => AlphaDesc {
-                mode: AlphaMode::Blend,
-                factor: node.float("opacity")?.unwrap_or(0.5),
-                texture: None,
-            },
-        };
-        BsdfDesc::Alpha {
-            alpha,
-            inner: Box::new(inner(ctx)?),
-        }
-    } else {
-        if node.prop("normalmap").is_none() {
-            return Err(node.error("normalmap needs a <texture name=\"normalmap\">"));
-        }
-        BsdfDesc::NormalMap {
-            map: ctx.texture(node, "normalmap", Vec3::Z)?,
-            inner: Box::new(inner(ctx)?),
+        _ => {
+            let weighted = node.children.iter().any(|c| c.name() == "weight");
+            if !weighted {
+                return Err(node.error("blendbsdf needs a `weight` (a float or a texture)"));
+            }
+            let b = inner.pop().expect("two nested");
+            BsdfDesc::Mix {
+                weight: scalar(ctx.texture(node, "weight", Vec3::ZERO)?),
+                a: Box::new(inner.pop().expect("two nested")),
+                b: Box::new(b),
+            }
         }
     };
     ctx.check_unused(node)?;
     Ok(d)
 }
 
+/// The BSDFs nested in a wrapper, in document order: `<bsdf>` children, and `<ref id>`s
+/// not naming a texture slot, to BSDFs as they were mapped where they are defined (where
+/// the wrapper sits inside a twosided, so does what it refers to).
+fn nested(ctx: &mut Ctx, node: &Node, in_two_sided: bool) -> Result<Vec<BsdfDesc>, LoadError> {
+    let mut out = Vec::new();
+    for c in &node.children {
+        if c.tag == "bsdf" {
+            c.used.set(true);
+            out.push(match in_two_sided {
+                true => two_sided(ctx, c)?,
+                false => bsdf(ctx, c)?,
+            });
+        } else if c.tag == "ref" && matches!(c.name(), "" | "bsdf") {
+            out.push(match ref_bsdf(ctx, c)? {
+                BsdfDesc::OneSided(d) if in_two_sided => *d,
+                d => d,
+            });
+        }
+    }
+    Ok(out)
+}
+
+/// A texture as Mitsuba's `eval_1` reads it for a scalar parameter (a mask's opacity, a
+/// blend's weight), in the first channel that Candela's scalar parameters read. Checked
+/// against Mitsuba 3.9.1:
+/// - a bitmap gives its luminance (Rec. 709 Y);
+/// - a constant colour gives its mean, which is how the RGB variants reduce a colour
+///   given inline;
+/// - a checkerboard gives its colours the other way round from `eval` (its squares'
+///   colours as a reflectance): at uv (0.05, 0.05) under a `to_uv` scale of 4, `eval`
+///   is `color0` and `eval_1` is `color1`.
+fn scalar(t: TextureDesc) -> TextureDesc {
+    let mean = |c: Vec3| Vec3::splat((c.x + c.y + c.z) / 3.0);
+    match t {
+        TextureDesc::Constant(c) => TextureDesc::Constant(mean(c)),
+        TextureDesc::Checker { a, b, uv_transform } => TextureDesc::Checker {
+            a: mean(b),
+            b: mean(a),
+            uv_transform,
+        },
+        TextureDesc::Image(mut t) => {
+            let luminance = |c: Vec3| Vec3::splat(c.dot(Vec3::new(0.2126, 0.7152, 0.0722)));
+            if t.image.pixels.iter().any(|c| c.x != c.y || c.y != c.z) {
+                let image = &*t.image;
+                t.image = std::sync::Arc::new(ImageDesc {
+                    pixels: image.pixels.iter().map(|&c| luminance(c)).collect(),
+                    ..*image
+                });
+            }
+            TextureDesc::Image(t)
+        }
+    }
+}
+
 /// The BSDF a wrapper's single `<ref id>` (one not naming a texture slot) refers to, as
 /// it was mapped where it is defined (one-sided unless it is a twosided); `None` without
 /// such a ref.
 fn referenced(ctx: &mut Ctx, node: &Node) -> Result<Option<BsdfDesc>, LoadError> {
-    let Some(r) = node
-        .children
+    node.children
         .iter()
         .find(|c| c.tag == "ref" && matches!(c.name(), "" | "bsdf"))
-    else {
-        return Ok(None);
-    };
+        .map(|r| ref_bsdf(ctx, r))
+        .transpose()
+}
+
+/// The BSDF a `<ref id>` names, as it was mapped where it is defined.
+fn ref_bsdf(ctx: &mut Ctx, r: &Node) -> Result<BsdfDesc, LoadError> {
     r.used.set(true);
     let id = r.req("id")?;
     let found = ctx.bsdf_ids.get(id).and_then(|name| {
@@ -249,10 +310,7 @@ fn referenced(ctx: &mut Ctx, node: &Node) -> Result<Option<BsdfDesc>, LoadError>
             .find(|m| &m.name == name)
             .map(|m| m.bsdf.clone())
     });
-    match found {
-        Some(d) => Ok(Some(d)),
-        None => Err(r.error(format!("no <bsdf> defined before it has the id \"{id}\""))),
-    }
+    found.ok_or_else(|| r.error(format!("no <bsdf> defined before it has the id \"{id}\"")))
 }
 
 /// η and k of a conductor: a `material` preset (default `none`, an ideal mirror), or

@@ -231,6 +231,7 @@ fn reads_uv(ctx: &Ctx, material: &str) -> bool {
             } => texture(base_color) || texture(metallic) || texture(roughness),
             BsdfDesc::NormalMap { .. } | BsdfDesc::Alpha { .. } => true,
             BsdfDesc::TwoSided(inner) | BsdfDesc::OneSided(inner) => bsdf(inner),
+            BsdfDesc::Mix { weight, a, b } => texture(weight) || bsdf(a) || bsdf(b),
             BsdfDesc::Conductor { .. } | BsdfDesc::Dielectric { .. } => false,
         }
     }
@@ -284,6 +285,7 @@ fn normal_mapped(ctx: &Ctx, material: &str) -> bool {
             BsdfDesc::NormalMap { .. } => true,
             BsdfDesc::TwoSided(inner) | BsdfDesc::OneSided(inner) => bsdf(inner),
             BsdfDesc::Alpha { inner, .. } => bsdf(inner),
+            BsdfDesc::Mix { a, b, .. } => bsdf(a) || bsdf(b),
             _ => false,
         }
     }
