@@ -48,23 +48,46 @@ fn assert_close(a: Vec3, b: Vec3, tol: f32) {
     assert!((a - b).abs().max_element() < tol, "{a} vs {b}");
 }
 
+/// Mitsuba 3.9.1's RGB (η, k) of its `Cu` conductor: `mi.traverse(mi.load_dict({'type':
+/// 'conductor', 'material': 'Cu'}))` in `scalar_rgb`.
+const MITSUBA_CU: ([f32; 3], [f32; 3]) =
+    ([0.201005, 0.92375, 1.10222], [3.91326, 2.45305, 2.14209]);
+
 #[test]
 fn conductors_take_presets_or_eta_and_k_and_are_one_sided() {
-    let (au_eta, au_k) = candela_core::bsdf::metal_preset("Au").unwrap();
-    match bsdf(r#"<bsdf type="conductor"><string name="material" value="Au"/></bsdf>"#) {
-        BsdfDesc::OneSided(inner) => match *inner {
-            BsdfDesc::Conductor {
-                eta,
-                k,
-                alpha_u,
-                alpha_v,
-                ..
-            } => {
-                assert_eq!((eta, k, alpha_u, alpha_v), (au_eta, au_k, 0.0, 0.0));
-            }
+    // Every material name Mitsuba knows, with the (η, k) its RGB variants use (3.9.1,
+    // read as for MITSUBA_CU): four of its 71 names, one a dielectric (k = 0).
+    for (name, eta, k) in [
+        (
+            "Au",
+            [0.143036, 0.375307, 1.44205],
+            [3.983, 2.38556, 1.60336],
+        ),
+        ("Cu", MITSUBA_CU.0, MITSUBA_CU.1),
+        (
+            "W",
+            [4.37082, 3.30025, 2.99841],
+            [3.50064, 2.60487, 2.27323],
+        ),
+        ("CsI_palik", [2.1449, 1.70232, 1.66243], [0.0, 0.0, 0.0]),
+    ] {
+        let body =
+            format!(r#"<bsdf type="conductor"><string name="material" value="{name}"/></bsdf>"#);
+        match bsdf(&body) {
+            BsdfDesc::OneSided(inner) => match *inner {
+                BsdfDesc::Conductor {
+                    eta: e,
+                    k: kk,
+                    alpha_u,
+                    alpha_v,
+                    ..
+                } => {
+                    assert_eq!((e, kk, alpha_u, alpha_v), (eta.into(), k.into(), 0.0, 0.0));
+                }
+                other => panic!("{other:?}"),
+            },
             other => panic!("{other:?}"),
-        },
-        other => panic!("{other:?}"),
+        }
     }
     // Mitsuba's default material "none" reflects everything: η = 0, k = 1.
     match bsdf(r#"<bsdf type="twosided"><bsdf type="conductor"/></bsdf>"#) {
@@ -166,8 +189,8 @@ fn conductors_take_presets_or_eta_and_k_and_are_one_sided() {
     );
     for (body, what) in [
         (
-            r#"<bsdf type="conductor"><string name="material" value="W"/></bsdf>"#,
-            "\"W\" is not among",
+            r#"<bsdf type="conductor"><string name="material" value="au"/></bsdf>"#,
+            "\"au\" is not one of Mitsuba's conductor materials",
         ),
         (
             r#"<bsdf type="conductor"><rgb name="eta" value="1"/></bsdf>"#,
@@ -196,7 +219,7 @@ fn a_conductors_specular_reflectance_scales_its_fresnel_term() {
     // Mitsuba's conductor.cpp and roughconductor.cpp multiply the Fresnel term by
     // specular_reflectance. The importer carries the colour over, and the built lobe is
     // the plain conductor's times it, for every direction (a closed form: same D, G).
-    let (eta, k) = candela_core::bsdf::metal_preset("Cu").unwrap();
+    let (eta, k) = (Vec3::from(MITSUBA_CU.0), Vec3::from(MITSUBA_CU.1));
     let scale = Vec3::new(0.5, 0.7, 0.9);
     let body = r#"<bsdf type="twosided"><bsdf type="roughconductor"><string name="material" value="Cu"/>
         <rgb name="specular_reflectance" value="0.5, 0.7, 0.9"/><float name="alpha" value="0.3"/></bsdf></bsdf>"#;

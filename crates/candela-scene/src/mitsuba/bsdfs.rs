@@ -4,12 +4,12 @@
 
 use candela_core::alpha::AlphaMode;
 
-use candela_core::bsdf::metal_preset;
 use candela_core::desc::{
     AlphaDesc, BsdfDesc, ImageDesc, MaterialDesc, MicrofacetDesc, TextureDesc,
 };
 use glam::Vec3;
 
+use super::conductors::MITSUBA_CONDUCTORS;
 use super::parse::Node;
 use super::{describe, Ctx};
 use crate::LoadError;
@@ -328,15 +328,15 @@ fn conductor_ior(ctx: &mut Ctx, node: &Node) -> Result<(Vec3, Vec3), LoadError> 
         }
         // η = 0, k = 1 reflects everything at every angle: Mitsuba's "none".
         (Some("none"), None, None) | (None, None, None) => Ok((Vec3::ZERO, Vec3::ONE)),
-        (Some(name), None, None) => match metal_preset(name) {
-            Some(p) => Ok(p),
+        (Some(name), None, None) => match MITSUBA_CONDUCTORS.iter().find(|c| c.0 == name) {
+            Some(&(_, eta, k)) => Ok((Vec3::from(eta), Vec3::from(k))),
             None => {
                 let p = node.prop("material").expect("read just now");
                 ctx.unsupported(
                     p,
                     format!(
-                        "conductor material \"{name}\" is not among Candela's presets \
-                         (Au, Ag, Cu, Al, Cr, none); give eta and k instead"
+                        "\"{name}\" is not one of Mitsuba's conductor materials \
+                         (Au, Ag, Cu, Al, Cr, W, … or none); give eta and k instead"
                     ),
                 )?;
                 Ok((Vec3::ZERO, Vec3::ONE))

@@ -6,6 +6,7 @@
 //! naming it (a warning under `lenient`), so nothing is silently dropped.
 
 mod bsdfs;
+mod conductors;
 mod emitters;
 mod parse;
 mod sensor;
