@@ -481,6 +481,81 @@ fn an_emitters_constant_spectrum_is_equal_energy_white_as_in_mitsubas_rgb_mode()
 }
 
 #[test]
+fn spectra_given_as_wavelength_pairs_reduce_to_mitsubas_rgb() {
+    // Mitsuba 3.9.1 scalar_rgb, for each spectrum below:
+    //   mi.traverse(mi.load_string('<bsdf version="3.0.0" type="diffuse">'
+    //     '<spectrum name="reflectance" value="400:0.0, 550:1.0, 700:0.0"/></bsdf>'))
+    // and likewise for a conductor's eta and k and a point light's intensity. A
+    // reflectance is weighed by D65 and clamped to [0, 1] (the second and third clamp),
+    // η and k by D65 and not clamped above, an emitter's colour by neither.
+    let s = "400:0.2, 500:2.5, 600:1.5, 700:3.0";
+    let c = "400:0, 500:8, 600:15.6, 700:18.4";
+    let desc = load(&scene(&format!(
+        r#"<shape type="cube"><bsdf type="diffuse"><spectrum name="reflectance" value="400:0.0, 550:1.0, 700:0.0"/></bsdf></shape>
+           <shape type="cube"><bsdf type="diffuse"><spectrum name="reflectance" value="400:1, 500:0 600:0,700:0"/></bsdf></shape>
+           <shape type="cube"><bsdf type="diffuse"><spectrum name="reflectance" value="{s}"/></bsdf></shape>
+           <shape type="cube"><bsdf type="conductor"><spectrum name="eta" value="{s}"/><spectrum name="k" value="{c}"/></bsdf></shape>
+           <emitter type="point"><spectrum name="intensity" value="{s}"/></emitter>
+           <emitter type="point"><spectrum name="intensity" value="{c}"/></emitter>"#
+    )));
+    let inner = |i: usize| {
+        let name = &desc.shapes[i].material;
+        match &desc
+            .materials
+            .iter()
+            .find(|m| &m.name == name)
+            .unwrap()
+            .bsdf
+        {
+            BsdfDesc::OneSided(inner) => inner.as_ref().clone(),
+            b => panic!("{b:?}"),
+        }
+    };
+    let albedo = |i: usize| match inner(i) {
+        BsdfDesc::Diffuse {
+            albedo: TextureDesc::Constant(c),
+        } => c,
+        b => panic!("{b:?}"),
+    };
+    let close = |a: Vec3, b: [f32; 3]| {
+        let b = Vec3::from(b);
+        assert!(
+            (a - b).abs().max_element() <= 2e-5 * b.max_element().max(1.0),
+            "{a} vs Mitsuba's {b}"
+        );
+    };
+    close(albedo(0), [0.5135267, 0.9042089, 0.3001395]);
+    close(albedo(1), [0.02843371, 0.0, 0.515323]);
+    close(albedo(2), [1.0, 1.0, 1.0]);
+    let BsdfDesc::Conductor { eta, k, .. } = inner(3) else {
+        panic!()
+    };
+    close(eta, [1.501708, 2.157423, 1.367805]);
+    close(k, [17.71471, 11.35443, 3.304508]);
+    let intensity = |i: usize| match desc.lights[i].kind {
+        LightKindDesc::Point { intensity, .. } => intensity,
+        ref other => panic!("{other:?}"),
+    };
+    close(intensity(0), [1.898967, 2.040142, 1.203149]);
+    close(intensity(1), [20.71084, 10.85463, 2.771152]);
+
+    // What Mitsuba refuses, refused at the element.
+    for (value, what) in [
+        ("400:0.5", "at least two wavelength:value pairs"),
+        ("500:1, 400:1", "wavelengths must rise"),
+        ("400:1 500", "\"500\" is not a wavelength:value pair"),
+    ] {
+        let e = load_err(&scene(&format!(
+            r#"<shape type="cube"><bsdf type="diffuse"><spectrum name="reflectance" value="{value}"/></bsdf></shape>"#
+        )));
+        assert!(
+            e.contains("scene.xml:2:41:") && e.contains(what),
+            "{value}: {e}"
+        );
+    }
+}
+
+#[test]
 fn meshes_without_normals_are_smoothed_as_mitsuba_does() {
     // Mitsuba recomputes angle-weighted vertex normals for an obj (or ply) without
     // normals unless face_normals is set:

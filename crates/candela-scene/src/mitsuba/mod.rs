@@ -11,6 +11,7 @@ mod emitters;
 mod parse;
 mod sensor;
 mod shapes;
+mod spectra;
 mod textures;
 mod transform;
 

@@ -9,6 +9,7 @@ use std::path::Path;
 use candela_core::desc::Span;
 use glam::Vec3;
 
+use super::spectra::{spectrum_to_rgb, SpectrumUse};
 use crate::{LoadError, Source};
 
 /// How deep `<include>`s may nest before we call it a cycle.
@@ -110,8 +111,27 @@ impl Node {
             .transpose()
     }
 
-    /// A colour: `rgb`, a constant `spectrum`, or a `float` (grey).
+    /// A colour: `rgb`, a `spectrum` (a constant, or wavelength:value pairs reduced as
+    /// Mitsuba's RGB variants do: see [`spectra`](super::spectra)), or a `float` (grey).
+    /// A conductor's `eta` and `k` are unbounded; other colours are reflectances.
     pub fn color(&self, name: &str) -> Result<Option<Vec3>, LoadError> {
+        let use_ = match name {
+            "eta" | "k" => SpectrumUse::Unbounded,
+            _ => SpectrumUse::Reflectance,
+        };
+        self.colour_as(name, use_)
+    }
+
+    /// An emitter's colour (`radiance`, `intensity`, `irradiance`): as [`Node::color`],
+    /// except that a spectrum is read as an illuminant: a constant `<spectrum value="v">`
+    /// is an equal-energy spectrum of v, which Mitsuba's RGB variants turn into
+    /// v·[`EQUAL_ENERGY_RGB`] (a BSDF's constant spectrum stays v in every channel), and
+    /// wavelength:value pairs are reduced without the D65 weighting.
+    pub fn illuminant(&self, name: &str) -> Result<Option<Vec3>, LoadError> {
+        self.colour_as(name, SpectrumUse::Emission)
+    }
+
+    fn colour_as(&self, name: &str, use_: SpectrumUse) -> Result<Option<Vec3>, LoadError> {
         let Some(p) = self.prop(name) else {
             return Ok(None);
         };
@@ -127,13 +147,23 @@ impl Node {
                          give the colour as <rgb>"
                     )));
                 }
-                let v = p.req("value")?;
-                if v.contains(':') {
+                if p.attr("filename").is_some() {
                     return Err(p.error(
-                        "spectrum given as wavelength:value pairs is not supported; use <rgb>",
+                        "a spectrum read from a file is not supported; give it as \
+                         wavelength:value pairs or <rgb>",
                     ));
                 }
-                Ok(Some(Vec3::splat(p.parse_f32(v)?)))
+                let v = p.req("value")?;
+                if v.contains(':') {
+                    return p
+                        .spectrum_pairs(v)
+                        .map(|pairs| Some(spectrum_to_rgb(&pairs, use_)));
+                }
+                let c = Vec3::splat(p.parse_f32(v)?);
+                Ok(Some(match use_ {
+                    SpectrumUse::Emission => c * EQUAL_ENERGY_RGB,
+                    SpectrumUse::Reflectance | SpectrumUse::Unbounded => c,
+                }))
             }
             "texture" => Err(p.error(format!(
                 "\"{name}\" must be a constant colour here, not a <texture>"
@@ -142,16 +172,25 @@ impl Node {
         }
     }
 
-    /// An emitter's colour (`radiance`, `intensity`, `irradiance`): as [`Node::color`],
-    /// except that a constant `<spectrum value="v">` is an equal-energy spectrum of v,
-    /// which Mitsuba's RGB variants turn into v·[`EQUAL_ENERGY_RGB`] where they read it
-    /// as an illuminant (a BSDF's constant spectrum stays v in every channel).
-    pub fn illuminant(&self, name: &str) -> Result<Option<Vec3>, LoadError> {
-        let scale = match self.children.iter().find(|c| c.name() == name) {
-            Some(c) if c.tag == "spectrum" => EQUAL_ENERGY_RGB,
-            _ => Vec3::ONE,
-        };
-        Ok(self.color(name)?.map(|c| c * scale))
+    /// `λ:v` pairs separated by commas and/or spaces, at least two, λ rising strictly.
+    fn spectrum_pairs(&self, v: &str) -> Result<Vec<(f64, f64)>, LoadError> {
+        let pairs = v
+            .split(|c: char| c == ',' || c.is_whitespace())
+            .filter(|s| !s.is_empty())
+            .map(|pair| match pair.split_once(':') {
+                Some((nm, value)) => {
+                    Ok((self.parse_f32(nm)? as f64, self.parse_f32(value)? as f64))
+                }
+                None => Err(self.error(format!("\"{pair}\" is not a wavelength:value pair"))),
+            })
+            .collect::<Result<Vec<_>, _>>()?;
+        if pairs.len() < 2 {
+            return Err(self.error("a spectrum needs at least two wavelength:value pairs"));
+        }
+        if pairs.windows(2).any(|w| w[0].0 >= w[1].0) {
+            return Err(self.error("a spectrum's wavelengths must rise from pair to pair"));
+        }
+        Ok(pairs)
     }
 
     /// A `point` or `vector`: `x`/`y`/`z` attributes (missing ones are 0) or `value`.
