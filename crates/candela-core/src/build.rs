@@ -641,13 +641,16 @@ fn build_material(bsdf: &BsdfDesc, span: &Span) -> Result<Material, BuildError> 
             alpha,
             distribution,
             linear,
+            specular,
         } => {
             check_eta(span, *eta)?;
+            check_color(span, "specular", *specular)?;
             let distrib = microfacet(span, *alpha, *alpha, *distribution)?;
             Material::Plastic {
                 albedo: build_texture(albedo, span, "albedo")?,
                 coat: Plastic {
                     linear: *linear,
+                    specular: *specular,
                     ..Plastic::rough(Vec3::ONE, *eta, distrib)
                 },
             }

@@ -198,6 +198,9 @@ pub enum BsdfDesc {
         /// The base term ρ/(1 − F_dr) (Mitsuba's default) instead of Candela's
         /// ρ/(1 − ρ F_dr), which saturates colours by the light the coat keeps inside.
         linear: bool,
+        /// Tints the coat's reflection (Mitsuba's `specular_reflectance`); one for a
+        /// clear coat.
+        specular: Vec3,
     },
     /// glTF 2.0 metallic-roughness: metallic and roughness read the texture's first
     /// channel (or the one an image texture selects) and lie in [0, 1].

@@ -25,7 +25,7 @@ use candela_core::sampler::Pcg32;
 use glam::{Vec2, Vec3};
 
 /// Number of chi-square cases in this file (for the Šidák correction).
-const CASES: usize = 155;
+const CASES: usize = 158;
 
 fn dir(theta_deg: f32, phi_deg: f32) -> Vec3 {
     let (t, p) = (theta_deg.to_radians(), phi_deg.to_radians());
@@ -277,5 +277,19 @@ fn plastic_and_metal_rough() {
                 seed,
             );
         }
+    }
+    // A tinted coat (Mitsuba's specular_reflectance) changes how often the coat is chosen.
+    for th in [10.0, 60.0, 85.0] {
+        seed += 1;
+        let lobe = Lobe::Plastic(Plastic {
+            specular: Vec3::new(0.2, 0.5, 0.9),
+            ..Plastic::rough(Vec3::new(0.8, 0.3, 0.1), 1.5, Microfacet::ggx(0.3, 0.3))
+        });
+        chi2_case(
+            &format!("tinted rough plastic θo={th}"),
+            lobe,
+            dir(th, 0.0),
+            seed,
+        );
     }
 }

@@ -138,6 +138,7 @@ struct MaterialEntry {
     distribution: Option<Distribution>,
     thin: Option<bool>,
     two_sided: Option<bool>,
+    specular: Option<Splat3>,
     materials: Option<Spanned<Vec<Spanned<String>>>>,
     weight: Option<Spanned<TexValue>>,
 }
@@ -166,7 +167,7 @@ fn allowed_keys(kind: &str) -> &'static [&'static str] {
             "distribution",
         ],
         "dielectric" => &["eta", "alpha", "alpha_u", "alpha_v", "distribution", "thin"],
-        "plastic" => &["albedo", "eta", "alpha", "distribution"],
+        "plastic" => &["albedo", "eta", "alpha", "distribution", "specular"],
         "metal_rough" => &["base_color", "metallic", "roughness"],
         "mix" => &["materials", "weight"],
         _ => &[],
@@ -261,6 +262,7 @@ pub(crate) fn parse_material(
             alpha: m.alpha.map_or(0.0, |n| n.0),
             distribution,
             linear: false,
+            specular: m.specular.map_or(Vec3::ONE, |c| c.0),
         },
         "metal_rough" => BsdfDesc::MetalRough {
             base_color: tex(m.base_color, Vec3::ONE, Slot::Color)?,

@@ -347,7 +347,15 @@ fn plastics_become_candelas_plastic_smooth_or_rough_linear_or_not() {
                 alpha,
                 distribution,
                 linear,
-            } => (c, eta, alpha, distribution, linear),
+                specular,
+            } => {
+                assert_eq!(
+                    specular,
+                    Vec3::ONE,
+                    "clear unless specular_reflectance says"
+                );
+                (c, eta, alpha, distribution, linear)
+            }
             other => panic!("{other:?}"),
         },
         other => panic!("{other:?}"),
@@ -376,6 +384,17 @@ fn plastics_become_candelas_plastic_smooth_or_rough_linear_or_not() {
     // A smooth plastic has no roughness to give.
     let (_, _, alpha, _, linear) = plastic(r#"<bsdf type="plastic"/>"#);
     assert_eq!((alpha, linear), (0.0, true));
+    // specular_reflectance tints the coat.
+    let b = bsdf(
+        r#"<bsdf type="plastic"><rgb name="specular_reflectance" value="0.2, 0.5, 0.9"/></bsdf>"#,
+    );
+    let BsdfDesc::OneSided(inner) = b else {
+        panic!("{b:?}")
+    };
+    assert!(
+        matches!(*inner, BsdfDesc::Plastic { specular, .. } if specular == Vec3::new(0.2, 0.5, 0.9)),
+        "{inner:?}"
+    );
     let e = load_err(
         r#"<shape type="cube"><bsdf type="plastic">
              <float name="alpha" value="0.2"/></bsdf></shape>"#,
@@ -447,6 +466,15 @@ fn a_rough_plastic_evaluates_close_to_mitsubas_roughplastic() {
         [0.320675, 0.276857, 0.254948],
         [0.0294463, 0.0128604, 0.00456748],
     ];
+    // The first case with specular_reflectance (0.2, 0.5, 0.9), which multiplies the
+    // coat's reflection and nothing else.
+    let ggx_linear_tinted = [
+        [0.141292, 0.063403, 0.0261782],
+        [0.163819, 0.0715302, 0.0261834],
+        [0.170314, 0.112248, 0.106904],
+        [0.12548, 0.15486, 0.230549],
+        [0.0291095, 0.0126499, 0.00452538],
+    ];
     let beckmann_nonlinear = [
         [0.114713, 0.0457590, 0.0206900],
         [0.133109, 0.0527549, 0.0235409],
@@ -459,6 +487,12 @@ fn a_rough_plastic_evaluates_close_to_mitsubas_roughplastic() {
             r#"<string name="distribution" value="ggx"/><float name="alpha" value="0.2"/>
                <float name="int_ior" value="1.5"/><float name="ext_ior" value="1"/>"#,
             ggx_linear,
+        ),
+        (
+            r#"<string name="distribution" value="ggx"/><float name="alpha" value="0.2"/>
+               <float name="int_ior" value="1.5"/><float name="ext_ior" value="1"/>
+               <rgb name="specular_reflectance" value="0.2, 0.5, 0.9"/>"#,
+            ggx_linear_tinted,
         ),
         (
             r#"<float name="alpha" value="0.5"/><boolean name="nonlinear" value="true"/>"#,

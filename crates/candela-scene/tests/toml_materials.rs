@@ -48,7 +48,12 @@ fn every_material_type_parses() {
     ));
     assert!(matches!(
         material("type = \"plastic\"\nalpha = 0.2\ndistribution = \"beckmann\"").unwrap(),
-        BsdfDesc::Plastic { alpha, distribution: MicrofacetDesc::Beckmann, .. } if alpha == 0.2
+        BsdfDesc::Plastic { alpha, distribution: MicrofacetDesc::Beckmann, specular, .. }
+            if alpha == 0.2 && specular == Vec3::ONE
+    ));
+    assert!(matches!(
+        material("type = \"plastic\"\nspecular = [0.9, 0.7, 0.2]").unwrap(),
+        BsdfDesc::Plastic { specular, .. } if specular == Vec3::new(0.9, 0.7, 0.2)
     ));
     assert!(matches!(
         material("type = \"metal_rough\"\nbase_color = 0.9\nmetallic = 1\nroughness = 0.4\ntwo_sided = true").unwrap(),

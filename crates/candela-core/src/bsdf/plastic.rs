@@ -31,7 +31,9 @@ use crate::sampling::{cosine_hemisphere_pdf, sample_cosine_hemisphere};
 /// scattering loses (light masked by the microfacets), so its albedo stays below that.
 ///
 /// With [`Plastic::linear`] the base term is ρ/(1 − F_dr,in) instead: Mitsuba's default,
-/// which ignores that inter-reflection saturates the base's colour.
+/// which ignores that inter-reflection saturates the base's colour. [`Plastic::specular`]
+/// tints the coat's reflection alone (Mitsuba's `specular_reflectance`; one for a clear
+/// coat), leaving the base as it is.
 #[derive(Clone, Copy, Debug)]
 pub struct Plastic {
     pub albedo: Vec3,
@@ -41,6 +43,8 @@ pub struct Plastic {
     /// The base term ρ/(1 − F_dr,in) instead of ρ/(1 − ρ F_dr,in) (Mitsuba's
     /// `nonlinear = false`).
     pub linear: bool,
+    /// Multiplies the coat's reflection (not what it lets through).
+    pub specular: Vec3,
     /// The coat's roughness; a delta mirror where it is effectively smooth.
     pub distrib: Microfacet,
     /// T(θ) of a rough coat (unused for a smooth one).
@@ -56,6 +60,7 @@ impl Plastic {
             eta,
             fdr_inside: fresnel_diffuse_reflectance(1.0 / eta),
             linear: false,
+            specular: Vec3::ONE,
             distrib: Microfacet::ggx(0.0, 0.0),
             transmittance: CoatTransmittance([1.0; COAT_TABLE]),
         }
@@ -73,6 +78,7 @@ impl Plastic {
             eta,
             fdr_inside: rough_internal_reflectance(&distrib, eta),
             linear: false,
+            specular: Vec3::ONE,
             distrib,
             transmittance: CoatTransmittance::new(&distrib, eta),
         }
@@ -93,10 +99,10 @@ impl Plastic {
     }
 
     /// Probability of choosing the coat's reflection when sampling from `wo`: its share
-    /// of the albedo, the base's share estimated by its brightest channel.
+    /// of the albedo, each part's estimated by its brightest channel.
     fn specular_probability(&self, cos_o: f32) -> f32 {
         let t = self.coat_transmittance(cos_o);
-        let specular = 1.0 - t;
+        let specular = (1.0 - t) * self.specular.max_element();
         let diffuse = t * self.albedo.max_element().min(1.0);
         if specular + diffuse <= 0.0 {
             return 1.0;
@@ -132,7 +138,7 @@ impl Plastic {
         if self.is_smooth() {
             return base;
         }
-        base + Vec3::splat(self.coat_f(wo, wi))
+        base + self.specular * self.coat_f(wo, wi)
     }
 
     pub fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
@@ -157,7 +163,7 @@ impl Plastic {
             let wi = Vec3::new(-wo.x, -wo.y, wo.z);
             let fo = fresnel_dielectric(wo.z, self.eta);
             return Some(BsdfSample {
-                f: Vec3::splat(fo / (ps * wi.z)),
+                f: self.specular * (fo / (ps * wi.z)),
                 wi,
                 pdf: 1.0,
                 flags: BsdfFlags::REFLECTION.union(BsdfFlags::DELTA),

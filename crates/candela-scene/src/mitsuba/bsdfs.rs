@@ -100,18 +100,10 @@ fn two_sided(ctx: &mut Ctx, node: &Node) -> Result<BsdfDesc, LoadError> {
         "conductor" | "roughconductor" => {
             let (eta, k) = conductor_ior(ctx, node)?;
             let (alpha_u, alpha_v, distribution) = roughness(node, kind == "roughconductor")?;
-            // Mitsuba multiplies the Fresnel term by it; a texture there is refused.
-            let specular = match node.prop("specular_reflectance") {
-                Some(p) if p.tag == "texture" => {
-                    unit_only(ctx, node, "specular_reflectance")?;
-                    Vec3::ONE
-                }
-                _ => node.color("specular_reflectance")?.unwrap_or(Vec3::ONE),
-            };
             BsdfDesc::Conductor {
                 eta,
                 k,
-                specular,
+                specular: specular_reflectance(ctx, node)?,
                 alpha_u,
                 alpha_v,
                 distribution,
@@ -145,13 +137,13 @@ fn two_sided(ctx: &mut Ctx, node: &Node) -> Result<BsdfDesc, LoadError> {
             if alpha_u != alpha_v {
                 return Err(node.error("roughplastic takes one alpha, not alpha_u and alpha_v"));
             }
-            unit_only(ctx, node, "specular_reflectance")?;
             BsdfDesc::Plastic {
                 albedo: ctx.texture(node, "diffuse_reflectance", Vec3::splat(0.5))?,
                 eta,
                 alpha: alpha_u,
                 distribution,
                 linear: !node.boolean("nonlinear")?.unwrap_or(false),
+                specular: specular_reflectance(ctx, node)?,
             }
         }
         "mask" | "normalmap" | "blendbsdf" => return wrapper(ctx, node, true),
@@ -311,6 +303,18 @@ fn ref_bsdf(ctx: &mut Ctx, r: &Node) -> Result<BsdfDesc, LoadError> {
             .map(|m| m.bsdf.clone())
     });
     found.ok_or_else(|| r.error(format!("no <bsdf> defined before it has the id \"{id}\"")))
+}
+
+/// `specular_reflectance`, which Mitsuba's conductors and plastics multiply their Fresnel
+/// reflection by, as a colour; a texture there is refused.
+fn specular_reflectance(ctx: &mut Ctx, node: &Node) -> Result<Vec3, LoadError> {
+    match node.prop("specular_reflectance") {
+        Some(p) if p.tag == "texture" => {
+            unit_only(ctx, node, "specular_reflectance")?;
+            Ok(Vec3::ONE)
+        }
+        _ => Ok(node.color("specular_reflectance")?.unwrap_or(Vec3::ONE)),
+    }
 }
 
 /// η and k of a conductor: a `material` preset (default `none`, an ideal mirror), or
