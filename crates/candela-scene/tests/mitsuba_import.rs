@@ -766,6 +766,74 @@ fn render_settings_follow_film_sampler_and_integrator() {
 }
 
 #[test]
+fn integrators_with_the_path_tracers_expectation_render_as_it() {
+    // The volumetric path tracers (no media), the particle tracer and the differentiable
+    // ones render what `path` renders in expectation, with their own default depth
+    // (Mitsuba 3.9.1: `str(mi.load_dict({'type': 'prb'}))` is max_depth = 6, `path`'s
+    // and `volpath`'s 4294967295, i.e. −1); `direct` is direct light only (max_depth 2).
+    for (kind, depth) in [
+        ("volpath", 1024),
+        ("volpathmis", 1024),
+        ("ptracer", 1024),
+        ("prb", 5),
+        ("prb_basic", 5),
+        ("direct", 1),
+    ] {
+        let r = load(&scene(&format!(r#"<integrator type="{kind}"/>"#))).render;
+        assert_eq!(
+            (r.max_depth, r.rr_depth, r.hide_emitters),
+            (depth, 5, false),
+            "{kind}"
+        );
+    }
+    let (_dir, loaded) = load_files(
+        &[(
+            "scene.xml",
+            &scene(
+                r#"<integrator type="volpath"><integer name="max_depth" value="4"/>
+                     <integer name="rr_depth" value="2"/><boolean name="hide_emitters" value="true"/></integrator>"#,
+            ),
+        )],
+        &[],
+        false,
+    );
+    let r = loaded.unwrap().desc.render;
+    assert_eq!((r.max_depth, r.rr_depth, r.hide_emitters), (3, 2, true));
+    // direct's sample counts change the noise only: read, and warned of.
+    let (_dir, loaded) = load_files(
+        &[(
+            "scene.xml",
+            &scene(
+                r#"<integrator type="direct"><integer name="emitter_samples" value="4"/>
+                     <integer name="bsdf_samples" value="1"/></integrator>"#,
+            ),
+        )],
+        &[],
+        false,
+    );
+    let loaded = loaded.unwrap();
+    assert_eq!(loaded.desc.render.max_depth, 1);
+    assert!(
+        loaded.warnings.len() == 1 && loaded.warnings[0].contains("emitter_samples"),
+        "{:?}",
+        loaded.warnings
+    );
+    // direct has no max_depth; other integrators are refused by name.
+    let e = load_err(&scene(
+        r#"<integrator type="direct"><integer name="max_depth" value="3"/></integrator>"#,
+    ));
+    assert!(
+        e.contains("scene.xml:2:27:") && e.contains("max_depth"),
+        "{e}"
+    );
+    let e = load_err(&scene(r#"<integrator type="aov"/>"#));
+    assert!(
+        e.contains("scene.xml:2:1:") && e.contains("<integrator type=\"aov\"> is not supported"),
+        "{e}"
+    );
+}
+
+#[test]
 fn unsupported_elements_are_errors_naming_them_or_warnings_when_lenient() {
     for (body, what) in [
         (

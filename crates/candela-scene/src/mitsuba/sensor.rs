@@ -31,19 +31,50 @@ pub fn candela_max_depth(m: i64) -> Result<u32, String> {
     }
 }
 
+/// The integrators whose image is the path tracer's in expectation, with the `max_depth`
+/// each takes by default (Mitsuba 3.9.1): the volumetric ones (no media here, which the
+/// importer refuses), the particle tracer, and the differentiable ones, whose primal
+/// image is a path tracer's.
+const PATH_INTEGRATORS: &[(&str, i64)] = &[
+    ("path", -1),
+    ("volpath", -1),
+    ("volpathmis", -1),
+    ("ptracer", -1),
+    ("prb", 6),
+    ("prb_basic", 6),
+    ("prb_projective", 6),
+];
+
+/// `<integrator>`: any of [`PATH_INTEGRATORS`], with `max_depth`, `rr_depth` and
+/// `hide_emitters`, or `direct`/`direct_projective`, direct light alone (Mitsuba's
+/// `max_depth` 2). Their own sampling knobs change the noise and not the expectation, so
+/// they are read and, away from their defaults, warned of.
 pub(crate) fn integrator(ctx: &mut Ctx, node: &Node) -> Result<(), LoadError> {
-    if node.kind() != "path" {
-        return ctx.unsupported(
-            node,
-            format!("<{}> is not supported (only \"path\" is)", describe(node)),
-        );
-    }
-    if let Some(m) = node.integer("max_depth")? {
-        let p = node.prop("max_depth").expect("read just now");
-        ctx.desc.render.max_depth = candela_max_depth(m).map_err(|e| p.error(e))?;
-    } else {
-        ctx.desc.render.max_depth = UNLIMITED_DEPTH;
-    }
+    let kind = node.kind();
+    let default_depth = match PATH_INTEGRATORS.iter().find(|(name, _)| *name == kind) {
+        Some(&(_, depth)) => depth,
+        None if matches!(kind, "direct" | "direct_projective") => 2,
+        None => {
+            let known: Vec<&str> = PATH_INTEGRATORS.iter().map(|(name, _)| *name).collect();
+            return ctx.unsupported(
+                node,
+                format!(
+                    "<{}> is not supported (only {} and direct are)",
+                    describe(node),
+                    known.join(", ")
+                ),
+            );
+        }
+    };
+    let depth = match kind {
+        "direct" | "direct_projective" => None,
+        _ => node.integer("max_depth")?,
+    };
+    let m = depth.unwrap_or(default_depth);
+    ctx.desc.render.max_depth = candela_max_depth(m).map_err(|e| match node.prop("max_depth") {
+        Some(p) => p.error(e),
+        None => node.error(e),
+    })?;
     if let Some(rr) = node.integer("rr_depth")? {
         let p = node.prop("rr_depth").expect("read just now");
         // Both count scattering events, so Mitsuba's value carries over as it is.
@@ -51,6 +82,28 @@ pub(crate) fn integrator(ctx: &mut Ctx, node: &Node) -> Result<(), LoadError> {
             .map_err(|_| p.error(format!("rr_depth {rr} is invalid: use 0 or more")))?;
     }
     ctx.desc.render.hide_emitters = node.boolean("hide_emitters")?.unwrap_or(false);
+    // Sample counts per pass or per shading point (one of each in Candela).
+    for knob in [
+        "emitter_samples",
+        "bsdf_samples",
+        "shading_samples",
+        "samples_per_pass",
+        "sppc",
+        "sppp",
+        "sppi",
+    ] {
+        if let Some(p) = node.prop(knob) {
+            if !matches!(p.attr("value"), Some("1") | Some("-1")) {
+                ctx.warn(
+                    p,
+                    format!(
+                        "{knob} is Mitsuba's sampling choice and does not change the \
+                         expected image; Candela renders {kind} as its path tracer"
+                    ),
+                );
+            }
+        }
+    }
     ctx.check_unused(node)
 }
 
