@@ -103,6 +103,10 @@ fn map_scene(root: Node, path: &Path, options: &LoadOptions) -> Result<LoadedSce
     })
 }
 
+/// A mesh file as a shape reads it: the path, the mesh's index in a serialized file (0
+/// for the others), `face_normals` and whether the uvs' v is flipped.
+pub(crate) type MeshKey = (std::path::PathBuf, u32, bool, bool);
+
 /// What the mapping builds up, and how strict it is.
 pub(crate) struct Ctx {
     pub lenient: bool,
@@ -115,8 +119,8 @@ pub(crate) struct Ctx {
     pub texture_ids: HashMap<String, TextureDesc>,
     /// The shapes of each `shapegroup` by its `id`, in the group's object space.
     pub shape_groups: HashMap<String, Vec<ShapeDesc>>,
-    /// Meshes loaded so far, by (file, face_normals, flip_tex_coords).
-    pub mesh_files: HashMap<(std::path::PathBuf, bool, bool), Arc<MeshDesc>>,
+    /// Meshes loaded so far.
+    pub mesh_files: HashMap<MeshKey, Arc<MeshDesc>>,
     pub desc: SceneDesc,
 }
 

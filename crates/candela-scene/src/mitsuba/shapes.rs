@@ -104,25 +104,40 @@ fn shape_desc(ctx: &mut Ctx, node: &Node) -> Result<Option<ShapeDesc>, LoadError
             radius: node.float("radius")?.unwrap_or(1.0),
         },
         "cylinder" => GeometryDesc::Mesh(Arc::new(cylinder(node)?)),
-        "obj" | "ply" => {
+        "obj" | "ply" | "serialized" => {
             let file = node
                 .string("filename")?
                 .ok_or_else(|| node.error(format!("{} needs a filename", describe(node))))?;
             let path = ctx.base.join(file);
             let face_normals = node.boolean("face_normals")?.unwrap_or(false);
-            // Mitsuba flips OBJ texture coordinates by default; no Candela texture reads
-            // them yet, so the flag is read and only honoured on the uvs.
-            let flip_uv = node
-                .boolean("flip_tex_coords")?
-                .unwrap_or(node.kind() == "obj");
+            // Mitsuba flips OBJ texture coordinates by default (a serialized mesh has no
+            // such option and keeps its uvs).
+            let flip_uv = match node.kind() {
+                "serialized" => false,
+                kind => node.boolean("flip_tex_coords")?.unwrap_or(kind == "obj"),
+            };
+            let index = match node.kind() {
+                "serialized" => match node.integer("shape_index")?.unwrap_or(0) {
+                    i @ 0..=0xffff_ffff => i as u32,
+                    i => {
+                        let p = node.prop("shape_index").expect("read just now");
+                        return Err(p.error(format!("shape_index {i} must be 0 or more")));
+                    }
+                },
+                _ => 0,
+            };
             // Shapes loading the same file the same way share one mesh, which the build
             // then instances.
-            let key = (path, face_normals, flip_uv);
+            let key = (path, index, face_normals, flip_uv);
             let mesh = match ctx.mesh_files.get(&key) {
                 Some(m) => m.clone(),
                 None => {
-                    let mut mesh = crate::load_mesh(&key.0)
-                        .map_err(|e| node.error(format!("cannot load mesh: {e}")))?;
+                    let loaded = match node.kind() {
+                        "serialized" => crate::serialized::load_serialized(&key.0, index),
+                        _ => crate::load_mesh(&key.0),
+                    };
+                    let mut mesh =
+                        loaded.map_err(|e| node.error(format!("cannot load mesh: {e}")))?;
                     // Mitsuba keeps a PLY's colours as an attribute that only a
                     // `mesh_attribute` texture reads; they do not tint the BSDF.
                     mesh.colors.clear();
