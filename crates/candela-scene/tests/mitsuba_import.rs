@@ -539,6 +539,38 @@ fn spectra_given_as_wavelength_pairs_reduce_to_mitsubas_rgb() {
     close(intensity(0), [1.898967, 2.040142, 1.203149]);
     close(intensity(1), [20.71084, 10.85463, 2.771152]);
 
+    // A spectrum file (`.spd`: a pair a line, `#` comments) beside the scene, as a
+    // reflectance and as an intensity (Mitsuba 3.9.1 reads the same numbers from the file
+    // as from the pairs inline).
+    let spd = "# test\n400 0.1\n500 0.6\n\n600 0.3\n700 0.9\n";
+    let xml = scene(
+        r#"<shape type="cube"><bsdf type="diffuse"><spectrum name="reflectance" filename="r.spd"/></bsdf></shape>
+           <emitter type="point"><spectrum name="intensity" filename="r.spd"/></emitter>"#,
+    );
+    let (_dir, loaded) = load_files(&[("scene.xml", &xml), ("r.spd", spd)], &[], false);
+    let desc = loaded.unwrap().desc;
+    let BsdfDesc::OneSided(inner) = &desc.materials[0].bsdf else {
+        panic!()
+    };
+    let BsdfDesc::Diffuse {
+        albedo: TextureDesc::Constant(albedo),
+    } = inner.as_ref()
+    else {
+        panic!()
+    };
+    close(*albedo, [0.3380708, 0.4875679, 0.3586755]);
+    let LightKindDesc::Point { intensity, .. } = desc.lights[0].kind else {
+        panic!()
+    };
+    close(intensity, [0.4329627, 0.4593427, 0.3177919]);
+    let e = load_err(&scene(
+        r#"<shape type="cube"><bsdf type="diffuse"><spectrum name="reflectance" filename="none.spd"/></bsdf></shape>"#,
+    ));
+    assert!(
+        e.contains("scene.xml:2:41:") && e.contains("none.spd"),
+        "{e}"
+    );
+
     // What Mitsuba refuses, refused at the element.
     for (value, what) in [
         ("400:0.5", "at least two wavelength:value pairs"),

@@ -147,11 +147,10 @@ impl Node {
                          give the colour as <rgb>"
                     )));
                 }
-                if p.attr("filename").is_some() {
-                    return Err(p.error(
-                        "a spectrum read from a file is not supported; give it as \
-                         wavelength:value pairs or <rgb>",
-                    ));
+                if let Some(file) = p.attr("filename") {
+                    return p
+                        .spectrum_file(file)
+                        .map(|pairs| Some(spectrum_to_rgb(&pairs, use_)));
                 }
                 let v = p.req("value")?;
                 if v.contains(':') {
@@ -170,6 +169,25 @@ impl Node {
             ))),
             other => Err(p.error(format!("\"{name}\" must be a colour, not <{other}>"))),
         }
+    }
+
+    /// A spectrum file (Mitsuba's `.spd`: a `λ v` pair a line, `#` comments), beside the
+    /// scene file that names it.
+    fn spectrum_file(&self, file: &str) -> Result<Vec<(f64, f64)>, LoadError> {
+        let dir = Path::new(&*self.span.file)
+            .parent()
+            .unwrap_or(Path::new(""));
+        let path = dir.join(file);
+        let text = std::fs::read_to_string(&path)
+            .map_err(|e| self.error(format!("cannot read \"{}\": {e}", path.display())))?;
+        let pairs: Vec<String> = text
+            .lines()
+            .map(str::trim)
+            .filter(|l| !l.is_empty() && !l.starts_with('#'))
+            .map(|l| l.split_whitespace().collect::<Vec<_>>().join(":"))
+            .collect();
+        self.spectrum_pairs(&pairs.join(", "))
+            .map_err(|e| self.error(format!("in \"{}\": {}", path.display(), e.message)))
     }
 
     /// `λ:v` pairs separated by commas and/or spaces, at least two, λ rising strictly.
