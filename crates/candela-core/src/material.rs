@@ -63,7 +63,8 @@ pub enum Material {
 impl Material {
     /// The BSDF at a point with shading normal `ns`, geometric normal `ng` and texture
     /// coordinates `uv`, with the tangent taken from the shading frame (so a normal map's
-    /// orientation is arbitrary; see [`Material::bsdf_with_tangent`]).
+    /// orientation is arbitrary; see [`Material::bsdf_with_tangent`]). The point is the
+    /// origin, so a [`Material::Mix`] always chooses the side it chooses there.
     pub fn bsdf(&self, ns: Vec3, ng: Vec3, uv: Vec2) -> Bsdf {
         self.bsdf_with_tangent(ns, ng, uv, Frame::from_z(ns).s)
     }
