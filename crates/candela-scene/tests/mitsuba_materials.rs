@@ -989,6 +989,27 @@ fn blendbsdfs_become_mixes_of_their_two_bsdfs_in_order() {
     assert!(matches!(one_sided(&a), BsdfDesc::Conductor { .. }), "{a:?}");
     assert!(matches!(one_sided(&b), BsdfDesc::Diffuse { .. }), "{b:?}");
     build(&desc).expect("a blend builds");
+    // A twosided around a <ref> to the blend makes both its BSDFs two-sided, as a blend
+    // nested in the twosided would be.
+    let desc = load(
+        r#"<bsdf type="blendbsdf" id="m"><float name="weight" value="0.5"/>
+             <bsdf type="diffuse"/><bsdf type="normalmap"><texture type="checkerboard" name="normalmap"/>
+               <bsdf type="conductor"/></bsdf></bsdf>
+           <shape type="cube"><bsdf type="twosided"><ref id="m"/></bsdf></shape>"#,
+    )
+    .desc;
+    let shape_material = &desc.shapes[0].material;
+    let m = desc
+        .materials
+        .iter()
+        .find(|m| &m.name == shape_material)
+        .unwrap();
+    let (_, a, b) = mix(m.bsdf.clone());
+    assert!(matches!(a, BsdfDesc::Diffuse { .. }), "{a:?}");
+    assert!(
+        matches!(&b, BsdfDesc::NormalMap { inner, .. } if matches!(**inner, BsdfDesc::Conductor { .. })),
+        "{b:?}"
+    );
 }
 
 #[test]

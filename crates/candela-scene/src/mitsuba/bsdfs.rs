@@ -64,8 +64,7 @@ fn bsdf(ctx: &mut Ctx, node: &Node) -> Result<BsdfDesc, LoadError> {
         let d = match inner.as_slice() {
             [one] => two_sided(ctx, one)?,
             [] => match referenced(ctx, node)? {
-                Some(BsdfDesc::OneSided(d)) => *d,
-                Some(d) => d,
+                Some(d) => two_sided_form(d),
                 None => return Err(node.error("twosided needs a nested <bsdf> or a <ref>")),
             },
             _ => {
@@ -239,10 +238,8 @@ fn nested(ctx: &mut Ctx, node: &Node, in_two_sided: bool) -> Result<Vec<BsdfDesc
                 false => bsdf(ctx, c)?,
             });
         } else if c.tag == "ref" && matches!(c.name(), "" | "bsdf") {
-            out.push(match ref_bsdf(ctx, c)? {
-                BsdfDesc::OneSided(d) if in_two_sided => *d,
-                d => d,
-            });
+            let d = ref_bsdf(ctx, c)?;
+            out.push(if in_two_sided { two_sided_form(d) } else { d });
         }
     }
     Ok(out)
@@ -277,6 +274,29 @@ fn scalar(t: TextureDesc) -> TextureDesc {
             }
             TextureDesc::Image(t)
         }
+    }
+}
+
+/// A BSDF as mapped where it was defined, as it reads inside a `twosided`: every
+/// one-sided part two-sided, through the wrappers and blends around it (Mitsuba's
+/// `twosided` shows each nested BSDF its front from either side).
+fn two_sided_form(d: BsdfDesc) -> BsdfDesc {
+    match d {
+        BsdfDesc::OneSided(inner) => *inner,
+        BsdfDesc::Mix { weight, a, b } => BsdfDesc::Mix {
+            weight,
+            a: Box::new(two_sided_form(*a)),
+            b: Box::new(two_sided_form(*b)),
+        },
+        BsdfDesc::NormalMap { map, inner } => BsdfDesc::NormalMap {
+            map,
+            inner: Box::new(two_sided_form(*inner)),
+        },
+        BsdfDesc::Alpha { alpha, inner } => BsdfDesc::Alpha {
+            alpha,
+            inner: Box::new(two_sided_form(*inner)),
+        },
+        d => d,
     }
 }
 
