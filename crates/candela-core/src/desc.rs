@@ -490,6 +490,19 @@ pub struct ProjectorLightDesc {
     pub image: Arc<ImageDesc>,
     pub color: LightColorDesc,
     pub amount: LightAmountDesc,
+    pub projection: ProjectionDesc,
+}
+
+/// How a projector's image gives its intensity.
+#[derive(Clone, Debug, Default)]
+pub enum ProjectionDesc {
+    /// I(ω) = scale × the pixel ω passes through, looked up nearest.
+    #[default]
+    PixelIntensity,
+    /// Mitsuba's `projector`: the texture (at uv from (0, 0) at the frustum's bottom-left
+    /// to (1, 1) at its top-right) is an irradiance E on the plane at distance 1, and
+    /// I(ω) = π · scale · E / cos³θ, θ from the axis.
+    PlaneIrradiance(TextureDesc),
 }
 
 /// A profile attached to the emitting shape `shape` (index into [`SceneDesc::shapes`]):

@@ -288,6 +288,7 @@ fn projector_reproduces_its_image_on_a_wall() {
         image,
         color: LightColorDesc::Rgb(Vec3::ONE),
         amount: LightAmountDesc::WattsPerSr(2.0),
+        projection: Default::default(),
     }))]);
     // forward −y, up −z, so right = forward × up = +x... (−y) × (−z) = +x.
     let (tx, ty) = (
@@ -456,6 +457,7 @@ fn bad_lights_are_build_errors() {
         }),
         color: LightColorDesc::Rgb(Vec3::ONE),
         amount: LightAmountDesc::WattsPerSr(1.0),
+        projection: Default::default(),
     }));
     assert!(e.contains("parallel"), "{e}");
 }

@@ -369,6 +369,7 @@ pub(crate) fn parse_light(src: &Source, base: &Path, item: Item) -> Result<Light
                 image: Arc::new(image),
                 color,
                 amount,
+                projection: Default::default(),
             })
         }
     };

@@ -771,6 +771,87 @@ fn spot_and_directional_emitters_map_with_mitsubas_defaults() {
 }
 
 /// An 8 × 4 EXR whose texel (i, j) is (i + 1, j + 1, 1).
+#[test]
+fn projectors_cast_their_irradiance_as_mitsubas_do() {
+    // Radiant intensity towards points, as Mitsuba 3.9.1 scalar_rgb gives it: for a
+    // projector `e` and a point p, `ds, spec = e.sample_direction(it, ...)` with
+    // it.p = p, then spec · ds.dist². The bitmap is 4 × 2, pixel (i, j) = (i + 1, j + 1,
+    // 10) with j = 0 the top row; Mitsuba looks it up bilinearly with repeat wrapping (the
+    // fourth point lies within half a texel of the corner, so it reads the opposite
+    // edges), and I = π · scale · E / cos³θ.
+    let dir = tempfile::tempdir().unwrap();
+    let pixels: Vec<f32> = (0..2)
+        .flat_map(|j| (0..4).flat_map(move |i| [i as f32 + 1.0, j as f32 + 1.0, 10.0]))
+        .collect();
+    exr::prelude::write_rgb_file(dir.path().join("p.exr"), 4, 2, |x, y| {
+        let k = 3 * (y * 4 + x);
+        (pixels[k], pixels[k + 1], pixels[k + 2])
+    })
+    .unwrap();
+    let bitmap = r#"<texture type="bitmap" name="irradiance"><string name="filename" value="p.exr"/></texture>"#;
+    /// Points and Mitsuba's intensity towards each.
+    type Points = [(Vec3, [f32; 3]); 5];
+    let cases: [(&str, Points); 3] = [
+        (
+            r#"<float name="fov" value="90"/><float name="scale" value="2"/>"#,
+            [
+                (Vec3::new(0.0, 0.0, 1.0), [15.708, 9.42478, 62.8319]),
+                (Vec3::new(0.25, 0.125, 1.0), [14.0674, 8.79212, 70.3369]),
+                (Vec3::new(-0.75, -0.25, 2.0), [25.3887, 13.6709, 78.1192]),
+                (Vec3::new(0.95, 0.45, 1.0), [42.2163, 26.8649, 191.893]),
+                (Vec3::new(0.5, -0.1, 0.7), [12.748, 21.2466, 118.981]),
+            ],
+        ),
+        (
+            r#"<float name="fov" value="60"/>
+               <transform name="to_world"><lookat origin="1, 2, 3" target="1, 2, 0" up="0, 1, 0"/></transform>"#,
+            [
+                (Vec3::new(1.0, 2.0, 2.0), [7.85398, 4.71239, 31.4159]),
+                (Vec3::new(0.75, 2.125, 2.0), [5.74644, 3.75243, 35.1685]),
+                (Vec3::new(1.75, 1.75, 1.0), [14.8389, 7.55027, 39.0596]),
+                (Vec3::new(0.05, 2.45, 2.0), [0.0, 0.0, 0.0]),
+                (Vec3::new(0.5, 1.9, 2.3), [0.0, 0.0, 0.0]),
+            ],
+        ),
+        // A constant irradiance of 1 (a 1 × 1 image, so a square frustum).
+        (
+            r#"<rgb name="irradiance" value="1"/><float name="fov" value="90"/>"#,
+            [
+                (Vec3::new(0.0, 0.0, 1.0), [std::f32::consts::PI; 3]), // Mitsuba: 3.14159
+                (Vec3::new(0.5, 0.0, 1.0), [4.39051; 3]),
+                (Vec3::new(0.0, 0.5, 1.0), [4.39051; 3]),
+                (Vec3::new(0.9, 0.4, 1.0), [8.68659; 3]),
+                (Vec3::new(2.0, 0.0, 1.0), [0.0; 3]),
+            ],
+        ),
+    ];
+    for (props, points) in cases {
+        let texture = if props.contains("irradiance") {
+            ""
+        } else {
+            bitmap
+        };
+        let xml = scene(&format!(
+            r#"<emitter type="projector">{texture}{props}</emitter>"#
+        ));
+        std::fs::write(dir.path().join("scene.xml"), &xml).unwrap();
+        let loaded =
+            load_scene_with(&dir.path().join("scene.xml"), &LoadOptions::default()).unwrap();
+        let built = build(&loaded.desc).unwrap();
+        let candela_core::light::Light::Projector(p) = &built.lights[0] else {
+            panic!("{:?}", loaded.desc.lights)
+        };
+        for (point, want) in points {
+            let i = p.intensity_towards((point - p.position).normalize());
+            let want = Vec3::from(want);
+            assert!(
+                (i - want).abs().max_element() <= 2e-5 * want.max_element().max(1.0),
+                "{props} {point}: {i} against Mitsuba's {want}"
+            );
+        }
+    }
+}
+
 fn exr_8x4(path: &std::path::Path) {
     exr::prelude::write_rgb_file(path, 8, 4, |i, j| ((i + 1) as f32, (j + 1) as f32, 1.0f32))
         .unwrap();

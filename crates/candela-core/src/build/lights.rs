@@ -15,10 +15,10 @@ use std::f32::consts::PI;
 
 use glam::Vec3;
 
-use super::{check_color, check_finite, check_image, err, BuildError};
+use super::{build_texture, check_color, check_finite, check_image, err, BuildError};
 use crate::desc::{
     GeometryDesc, LightAmountDesc, LightColorDesc, LightDesc, LightKindDesc, ProfileDesc,
-    SceneDesc, Span,
+    ProjectionDesc, SceneDesc, Span,
 };
 use crate::light::blackbody::blackbody_rgb;
 use crate::light::{
@@ -249,6 +249,9 @@ pub(super) fn build_light(l: &LightDesc) -> Result<Light, BuildError> {
                 img.clone(),
                 Vec3::ONE,
             );
+            if let ProjectionDesc::PlaneIrradiance(t) = &p.projection {
+                proj = proj.with_plane_irradiance(build_texture(t, span, "projector irradiance")?);
+            }
             let omega = luminance(proj.image_integral());
             proj.scale = scale(span, p.color, p.amount, omega, None)?;
             Light::Projector(proj)

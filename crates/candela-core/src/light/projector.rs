@@ -2,12 +2,13 @@
 
 use std::sync::Arc;
 
-use glam::Vec3;
+use glam::{Vec2, Vec3};
 
 use super::{positional, LightBounds, LightSample, ShadingCtx};
 use crate::desc::ImageDesc;
 use crate::geometry::Aabb;
 use crate::math::luminance;
+use crate::texture::Texture;
 
 /// A point light at `position` whose intensity towards ω is `scale` times the linear
 /// value of the image pixel ω passes through, the image spanning the frustum
@@ -24,6 +25,9 @@ pub struct ProjectorLight {
     pub tan_y: f32,
     pub image: Arc<ImageDesc>,
     pub scale: Vec3,
+    /// Mitsuba's projection (see [`ProjectorLight::with_plane_irradiance`]); `None` for
+    /// intensity per pixel.
+    pub plane_irradiance: Option<Texture>,
     /// ∫ image(ω) dω per channel (sr).
     image_integral: Vec3,
 }
@@ -57,6 +61,7 @@ impl ProjectorLight {
             tan_y: (0.5 * fov_y_rad).tan(),
             image,
             scale,
+            plane_irradiance: None,
             image_integral: Vec3::ZERO,
         };
         let sum = p
@@ -83,13 +88,35 @@ impl ProjectorLight {
         })
     }
 
+    /// The light with Mitsuba's projection: `texture`, read at uv ((x + 1)/2, (y + 1)/2)
+    /// for x, y in [−1, 1] across the frustum (right and up), is the irradiance E on the
+    /// plane at distance 1, so that I(ω) = π · scale · E / cos³θ; `image` gives only the
+    /// power estimate, π · scale × the plane window's area × the mean pixel (exact for a
+    /// constant, close for a bilinear texture).
+    pub fn with_plane_irradiance(self, texture: Texture) -> ProjectorLight {
+        let n = self.image.pixels.len().max(1) as f64;
+        let mean = self
+            .image
+            .pixels
+            .iter()
+            .fold(glam::DVec3::ZERO, |acc, p| acc + p.as_dvec3())
+            / n;
+        let area = 4.0 * self.tan_x as f64 * self.tan_y as f64;
+        ProjectorLight {
+            plane_irradiance: Some(texture),
+            image_integral: (mean * area * std::f64::consts::PI).as_vec3(),
+            ..self
+        }
+    }
+
     /// ∫ image(ω) dω per channel: what turns `scale` into a power per channel.
     pub fn image_integral(&self) -> Vec3 {
         self.image_integral
     }
 
-    /// The pixel that the unit direction `w` leaving the light passes through.
-    pub fn pixel_towards(&self, w: Vec3) -> Option<usize> {
+    /// Where the unit direction `w` leaving the light crosses the frustum: x and y in
+    /// [−1, 1] (right and up), and the cosine to the axis; `None` outside it.
+    fn frustum_point(&self, w: Vec3) -> Option<(f32, f32, f32)> {
         let z = w.dot(self.forward);
         if z <= 0.0 {
             return None;
@@ -99,6 +126,12 @@ impl ProjectorLight {
         if !(-1.0..=1.0).contains(&x) || !(-1.0..=1.0).contains(&y) {
             return None;
         }
+        Some((x, y, z))
+    }
+
+    /// The pixel that the unit direction `w` leaving the light passes through.
+    pub fn pixel_towards(&self, w: Vec3) -> Option<usize> {
+        let (x, y, _) = self.frustum_point(w)?;
         let (wd, ht) = (self.image.width, self.image.height);
         let col = (((x + 1.0) * 0.5 * wd as f32) as u32).min(wd - 1);
         let row = (((1.0 - y) * 0.5 * ht as f32) as u32).min(ht - 1);
@@ -107,8 +140,15 @@ impl ProjectorLight {
 
     /// Radiant intensity (W/sr) towards the unit direction `w` leaving the light.
     pub fn intensity_towards(&self, w: Vec3) -> Vec3 {
-        self.pixel_towards(w)
-            .map_or(Vec3::ZERO, |i| self.scale * self.image.pixels[i])
+        match &self.plane_irradiance {
+            None => self
+                .pixel_towards(w)
+                .map_or(Vec3::ZERO, |i| self.scale * self.image.pixels[i]),
+            Some(texture) => self.frustum_point(w).map_or(Vec3::ZERO, |(x, y, cos)| {
+                let e = texture.eval(Vec2::new(0.5 * (x + 1.0), 0.5 * (y + 1.0)));
+                self.scale * e * (std::f32::consts::PI / (cos * cos * cos))
+            }),
+        }
     }
 
     pub fn sample_li(&self, ctx: &ShadingCtx) -> Option<LightSample> {
@@ -122,19 +162,25 @@ impl ProjectorLight {
     }
 
     /// Emission within the cone through the frustum's corners (θ_o), nothing beyond
-    /// (θ_e = 0), at most the brightest pixel.
+    /// (θ_e = 0), at most the brightest pixel (for Mitsuba's projection, times π/cos³
+    /// at the corners, where it is largest).
     pub fn bounds(&self) -> LightBounds {
-        let peak = self
+        let cos_corner = 1.0 / (1.0 + self.tan_x * self.tan_x + self.tan_y * self.tan_y).sqrt();
+        let pixel_peak = self
             .image
             .pixels
             .iter()
             .map(|&c| luminance(self.scale * c))
             .fold(0.0f32, f32::max);
+        let peak = match self.plane_irradiance {
+            None => pixel_peak,
+            Some(_) => pixel_peak * std::f32::consts::PI / cos_corner.powi(3),
+        };
         LightBounds {
             aabb: Aabb::from_points(&[self.position]),
             w: self.forward,
             intensity: peak,
-            cos_theta_o: 1.0 / (1.0 + self.tan_x * self.tan_x + self.tan_y * self.tan_y).sqrt(),
+            cos_theta_o: cos_corner,
             cos_theta_e: 1.0,
             two_sided: false,
         }

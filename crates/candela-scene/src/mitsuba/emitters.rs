@@ -2,13 +2,17 @@
 
 use std::f32::consts::PI;
 
+use std::sync::Arc;
+
 use candela_core::desc::{
-    DirectionalLightDesc, EnvironmentDesc, EnvironmentMapDesc, LightAmountDesc, LightColorDesc,
-    LightDesc, LightKindDesc, SpotFalloff, SpotLightDesc,
+    DirectionalLightDesc, EnvironmentDesc, EnvironmentMapDesc, ImageDesc, LightAmountDesc,
+    LightColorDesc, LightDesc, LightKindDesc, ProjectionDesc, ProjectorLightDesc, SpotFalloff,
+    SpotLightDesc, TextureDesc,
 };
-use glam::{Mat3, Mat4, Vec3};
+use glam::{Affine2, Mat3, Mat4, Vec2, Vec3};
 
 use super::parse::Node;
+use super::sensor::{field_of_view, vertical_fov};
 use super::{describe, transform, Ctx};
 use crate::environment::load_linear_image;
 use crate::LoadError;
@@ -60,6 +64,10 @@ pub(crate) fn emitter(ctx: &mut Ctx, node: &Node) -> Result<(), LoadError> {
                 amount: LightAmountDesc::WattsPerSr(1.0),
             })
         }
+        "projector" => match projector(ctx, node)? {
+            Some(kind) => kind,
+            None => return Ok(()),
+        },
         "envmap" | "constant" => return environment(ctx, node),
         "area" => return Err(node.error("an area emitter must sit inside a <shape>")),
         _ => return ctx.unsupported(node, format!("<{}> is not supported", describe(node))),
@@ -70,6 +78,73 @@ pub(crate) fn emitter(ctx: &mut Ctx, node: &Node) -> Result<(), LoadError> {
         span: node.span.clone(),
     });
     Ok(())
+}
+
+/// `projector`: Candela's projector in Mitsuba's projection (see
+/// [`ProjectionDesc::PlaneIrradiance`]). It looks along its local +z with +y up and the
+/// image's right along −x, as Mitsuba's cameras do, and so as Candela's frame (right =
+/// forward × up) puts it; `fov` (default a 50 mm lens) spans `fov_axis` of the
+/// irradiance texture's aspect. Measured with Mitsuba 3.9.1's `sample_direction`:
+/// I(ω) = π · scale · E(uv) / cos³θ, E looked up as its bitmap is (bilinear, `wrap_mode`).
+/// `None` where `--lenient` skips it.
+fn projector(ctx: &mut Ctx, node: &Node) -> Result<Option<LightKindDesc>, LoadError> {
+    let textured = node
+        .children
+        .iter()
+        .any(|c| c.name() == "irradiance" && matches!(c.tag.as_str(), "texture" | "ref"));
+    let (texture, image) = if textured {
+        match ctx.texture(node, "irradiance", Vec3::ONE)? {
+            TextureDesc::Image(mut t) => {
+                // The importer reads a bitmap at Mitsuba's uvs (v = 0 the top row); the
+                // projector reads it with v up, so v is flipped back first.
+                let v_up = Affine2::from_cols(Vec2::X, Vec2::NEG_Y, Vec2::Y);
+                t.uv_transform *= v_up;
+                let image = t.image.clone();
+                (TextureDesc::Image(t), image)
+            }
+            _ => {
+                ctx.unsupported(
+                    node,
+                    "a projector's irradiance must be a bitmap or a colour".into(),
+                )?;
+                return Ok(None);
+            }
+        }
+    } else {
+        let c = node.illuminant("irradiance")?.unwrap_or(Vec3::ONE);
+        let image = ImageDesc {
+            width: 1,
+            height: 1,
+            pixels: vec![c],
+        };
+        (TextureDesc::Constant(c), Arc::new(image))
+    };
+    let aspect = image.width as f32 / image.height as f32;
+    let (fov, axis) = field_of_view(node)?;
+    let fov_y = vertical_fov(fov, axis, aspect).ok_or_else(|| {
+        node.error(format!(
+            "fov_axis \"{axis}\" is not one of x, y, diagonal, smaller, larger"
+        ))
+    })?;
+    let fov_x = 2.0
+        * ((0.5 * fov_y).to_radians().tan() * aspect)
+            .atan()
+            .to_degrees();
+    let to_world = to_world(node)?;
+    if Mat3::from_mat4(to_world).determinant() < 0.0 {
+        return Err(node.error("a projector's to_world must not mirror"));
+    }
+    Ok(Some(LightKindDesc::Projector(ProjectorLightDesc {
+        position: to_world.transform_point3(Vec3::ZERO),
+        direction: to_world.transform_vector3(Vec3::Z),
+        up: to_world.transform_vector3(Vec3::Y),
+        fov_x_deg: fov_x,
+        fov_y_deg: fov_y,
+        image,
+        color: LightColorDesc::Rgb(Vec3::ONE),
+        amount: LightAmountDesc::WattsPerSr(node.float("scale")?.unwrap_or(1.0)),
+        projection: ProjectionDesc::PlaneIrradiance(texture),
+    })))
 }
 
 /// `envmap` and `constant`: Candela's environment.

@@ -180,7 +180,7 @@ fn ortho_height(node: &Node, to_world: Mat4, aspect: f32) -> Result<f32, LoadErr
 /// `focal_length` ("50mm" when neither it nor `fov` is given) is a 35 mm film
 /// equivalent: the fov spans the film's diagonal, 2·atan(√(36² + 24²)/(2f)), and
 /// `fov_axis` is not read (Mitsuba reports it as unused).
-fn field_of_view(node: &Node) -> Result<(f32, &str), LoadError> {
+pub(crate) fn field_of_view(node: &Node) -> Result<(f32, &str), LoadError> {
     let Some(p) = node.prop("focal_length") else {
         return Ok(match node.float("fov")? {
             Some(fov) => (fov, node.string("fov_axis")?.unwrap_or("x")),
