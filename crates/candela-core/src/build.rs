@@ -680,13 +680,11 @@ fn build_material(bsdf: &BsdfDesc, span: &Span) -> Result<Material, BuildError> 
                     );
                 }
             }
-            let (a, b) = (build_material(a, span)?, build_material(b, span)?);
-            Material::Mix {
-                weight: build_texture(weight, span, "mix weight")?,
-                level: 1 + a.mix_level().max(b.mix_level()),
-                a: Box::new(a),
-                b: Box::new(b),
-            }
+            Material::mix(
+                build_texture(weight, span, "mix weight")?,
+                build_material(a, span)?,
+                build_material(b, span)?,
+            )
         }
     })
 }

@@ -167,8 +167,18 @@ impl Material {
         }
     }
 
+    /// The [`Material::Mix`] of `a` and `b` by `weight`, its level one above theirs.
+    pub fn mix(weight: Texture, a: Material, b: Material) -> Material {
+        Material::Mix {
+            weight,
+            level: 1 + a.mix_level().max(b.mix_level()),
+            a: Box::new(a),
+            b: Box::new(b),
+        }
+    }
+
     /// The [`Material::Mix`] `level` of this material: 0 for one holding no mix.
-    pub fn mix_level(&self) -> u32 {
+    fn mix_level(&self) -> u32 {
         match self {
             Material::Mix { level, .. } => *level,
             Material::NormalMap { inner, .. } | Material::OneSided(inner) => inner.mix_level(),
@@ -265,15 +275,6 @@ mod mix_tests {
         }
     }
 
-    fn mix(weight: Texture, a: Material, b: Material) -> Material {
-        Material::Mix {
-            weight,
-            level: 1 + a.mix_level().max(b.mix_level()),
-            a: Box::new(a),
-            b: Box::new(b),
-        }
-    }
-
     /// The albedo of the lobe `m` chooses at point `p` and texture coordinates `uv`.
     fn chosen(m: &Material, p: Vec3, uv: Vec2) -> f32 {
         let si = SurfaceInteraction {
@@ -312,10 +313,10 @@ mod mix_tests {
         // against 0.7, 0.3·0.4 and 0.3·0.6, by chi-square with 2 degrees of freedom at
         // α = 10⁻³ (13.82). The inner mix's choice would be fixed by the outer one's if
         // both hashed the point alike (then 0.3·0.4 would never come up).
-        let m = mix(
+        let m = Material::mix(
             Texture::Constant(Vec3::splat(0.3)),
             diffuse(0.1),
-            mix(
+            Material::mix(
                 Texture::Constant(Vec3::splat(0.6)),
                 diffuse(0.2),
                 diffuse(0.4),
@@ -344,7 +345,7 @@ mod mix_tests {
     fn a_mix_weight_is_read_where_the_point_is_and_clamped_to_0_1() {
         // A checker weight of 1.5 and −0.5: the second material on the squares above 1,
         // the first on those below 0, at every point.
-        let m = mix(
+        let m = Material::mix(
             Texture::Checker {
                 a: Vec3::splat(1.5),
                 b: Vec3::splat(-0.5),

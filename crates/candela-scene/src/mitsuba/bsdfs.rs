@@ -3,6 +3,7 @@
 //! so an unwrapped one becomes [`BsdfDesc::OneSided`]. Dielectrics are two-sided in both.
 
 use candela_core::alpha::AlphaMode;
+use candela_core::math::luminance;
 
 use candela_core::desc::{
     AlphaDesc, BsdfDesc, ImageDesc, MaterialDesc, MicrofacetDesc, TextureDesc,
@@ -264,11 +265,14 @@ fn scalar(t: TextureDesc) -> TextureDesc {
             uv_transform,
         },
         TextureDesc::Image(mut t) => {
-            let luminance = |c: Vec3| Vec3::splat(c.dot(Vec3::new(0.2126, 0.7152, 0.0722)));
             if t.image.pixels.iter().any(|c| c.x != c.y || c.y != c.z) {
                 let image = &*t.image;
                 t.image = std::sync::Arc::new(ImageDesc {
-                    pixels: image.pixels.iter().map(|&c| luminance(c)).collect(),
+                    pixels: image
+                        .pixels
+                        .iter()
+                        .map(|&c| Vec3::splat(luminance(c)))
+                        .collect(),
                     ..*image
                 });
             }

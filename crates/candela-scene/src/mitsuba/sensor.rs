@@ -51,9 +51,10 @@ const PATH_INTEGRATORS: &[(&str, i64)] = &[
 /// they are read and, away from their defaults, warned of.
 pub(crate) fn integrator(ctx: &mut Ctx, node: &Node) -> Result<(), LoadError> {
     let kind = node.kind();
+    let direct = matches!(kind, "direct" | "direct_projective");
     let default_depth = match PATH_INTEGRATORS.iter().find(|(name, _)| *name == kind) {
         Some(&(_, depth)) => depth,
-        None if matches!(kind, "direct" | "direct_projective") => 2,
+        None if direct => 2,
         None => {
             let known: Vec<&str> = PATH_INTEGRATORS.iter().map(|(name, _)| *name).collect();
             return ctx.unsupported(
@@ -66,9 +67,11 @@ pub(crate) fn integrator(ctx: &mut Ctx, node: &Node) -> Result<(), LoadError> {
             );
         }
     };
-    let depth = match kind {
-        "direct" | "direct_projective" => None,
-        _ => node.integer("max_depth")?,
+    // `direct` has no max_depth: one given is left unread, and so refused below.
+    let depth = if direct {
+        None
+    } else {
+        node.integer("max_depth")?
     };
     let m = depth.unwrap_or(default_depth);
     ctx.desc.render.max_depth = candela_max_depth(m).map_err(|e| match node.prop("max_depth") {
