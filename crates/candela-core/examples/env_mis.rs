@@ -63,6 +63,7 @@ fn scene(width: u32, height: u32) -> SceneDesc {
         geometry,
         material: material.into(),
         emission: None,
+        emission_texture: None,
         transform,
         flip_normals: false,
         span: Span::code(),

@@ -87,6 +87,7 @@ fn main() {
             geometry: GeometryDesc::Mesh(geometry),
             material: "white".into(),
             emission: None,
+            emission_texture: None,
             transform: Mat4::from_scale_rotation_translation(
                 Vec3::splat(1.0 + 0.2 * (k % 3) as f32),
                 Quat::from_rotation_y(k as f32),

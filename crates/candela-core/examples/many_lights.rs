@@ -110,6 +110,7 @@ fn shape(geometry: GeometryDesc, transform: Mat4, emission: Option<Vec3>) -> Sha
         geometry,
         material: "white".into(),
         emission,
+        emission_texture: None,
         transform,
         flip_normals: false,
         span: Span::code(),

@@ -140,6 +140,19 @@ pub fn build(desc: &SceneDesc) -> Result<Scene, BuildError> {
             return err(&shape.span, "transform is singular");
         }
         let emission = shape.emission.filter(|le| *le != Vec3::ZERO);
+        let emission_texture = match &shape.emission_texture {
+            None => None,
+            Some(_) if shape.emission.is_none() => {
+                return err(&shape.span, "an emission texture needs an `emission`");
+            }
+            Some(_) if matches!(shape.geometry, GeometryDesc::Sphere { .. }) => {
+                return err(
+                    &shape.span,
+                    "emission textures are not supported on spheres",
+                );
+            }
+            Some(t) => Some(Arc::new(build_texture(t, &shape.span, "emission texture")?)),
+        };
         match &shape.geometry {
             GeometryDesc::Sphere { .. } if alphas[material.0 as usize].is_some() => {
                 return err(
@@ -193,7 +206,8 @@ pub fn build(desc: &SceneDesc) -> Result<Scene, BuildError> {
                 mesh.flip_normals = shape.flip_normals;
                 mesh.alpha = alphas[material.0 as usize].clone();
                 if let Some(le) = emission {
-                    lights::triangle_lights(desc, shape_index, &mut mesh, le, &mut lights);
+                    let texture = emission_texture.as_ref();
+                    lights::triangle_lights(desc, shape_index, &mut mesh, le, texture, &mut lights);
                 }
                 mesh.cache_face_normals();
                 meshes.push(mesh);

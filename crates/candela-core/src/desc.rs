@@ -327,6 +327,10 @@ pub struct ShapeDesc {
     /// Emitted radiance (W·sr⁻¹·m⁻²) on the side the surface normal points to; this makes
     /// the shape an area light.
     pub emission: Option<Vec3>,
+    /// Multiplies `emission` at each point, looked up at the surface's uvs (a screen, a
+    /// stained-glass window, glTF's emissive texture). Meshes and the unit primitives
+    /// take one; spheres do not.
+    pub emission_texture: Option<TextureDesc>,
     /// Object to world.
     pub transform: Mat4,
     /// Turns the surface's normals (and so the side an area light emits from) around.

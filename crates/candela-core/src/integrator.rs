@@ -294,7 +294,7 @@ fn li_isa<S: Sampler, const V3: bool>(
         };
         let wo = -ray.d;
         if let Some(id) = si.light {
-            let le = scene.light(id).radiance(si.ng, wo);
+            let le = scene.light(id).radiance(si.ng, si.uv, wo);
             if le != Vec3::ZERO {
                 l += beta * le * emitter_weight(specular, &prev_ctx, prev_bsdf_pdf, id, ray.d);
             }

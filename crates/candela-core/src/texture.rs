@@ -42,6 +42,42 @@ impl Texture {
     pub fn eval_scalar(&self, uv: Vec2) -> f32 {
         self.eval(uv).x
     }
+
+    /// The mean over one period of uv: an image's mean texel (its channel and scale
+    /// applied), the mean of a checker's two colours.
+    pub fn mean(&self) -> Vec3 {
+        match self {
+            Texture::Constant(c) => *c,
+            Texture::Image(t) => {
+                let img = &t.image;
+                let sum = img
+                    .pixels
+                    .iter()
+                    .fold(glam::DVec3::ZERO, |s, p| s + p.as_dvec3());
+                let v = (sum / img.pixels.len().max(1) as f64).as_vec3();
+                let v = match t.channel {
+                    Some(c) => Vec3::splat(v[c.min(2) as usize]),
+                    None => v,
+                };
+                v * t.scale
+            }
+            Texture::Checker { a, b, .. } => 0.5 * (*a + *b),
+        }
+    }
+
+    /// How many lookups a unit of uv area needs to see what the texture holds: an
+    /// image's texels, four a checker square, none for a constant (both after the uv
+    /// transform's change of area).
+    pub fn detail(&self) -> f32 {
+        match self {
+            Texture::Constant(_) => 0.0,
+            Texture::Image(t) => {
+                let texels = t.image.width as f32 * t.image.height as f32;
+                texels * t.uv_transform.matrix2.determinant().abs()
+            }
+            Texture::Checker { uv_transform, .. } => 4.0 * uv_transform.matrix2.determinant().abs(),
+        }
+    }
 }
 
 /// An image lookup with bilinear filtering. Texel (i, j) (row j from the top) has its

@@ -27,6 +27,7 @@ fn shape(geometry: GeometryDesc, material: &str, le: Option<f32>, transform: Mat
         geometry,
         material: material.into(),
         emission: le.map(Vec3::splat),
+        emission_texture: None,
         transform,
         flip_normals: false,
         span: Span::code(),

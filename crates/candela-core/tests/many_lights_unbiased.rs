@@ -46,6 +46,7 @@ fn scene(kind: LightSamplerKind, mis: MisMode, seed: u64) -> candela_core::Scene
         geometry,
         material: "white".into(),
         emission,
+        emission_texture: None,
         transform,
         flip_normals: false,
         span: Span::code(),

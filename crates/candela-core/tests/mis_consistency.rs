@@ -96,6 +96,7 @@ fn cornell(mis: MisMode, light_scale: f32) -> SceneDesc {
             })),
             material: material.to_string(),
             emission: (*material == "light").then(|| Vec3::new(17.0, 12.0, 4.0) * light_scale),
+            emission_texture: None,
             transform: Mat4::IDENTITY,
             flip_normals: false,
             span: Span::code(),

@@ -57,6 +57,7 @@ fn plane_scene(lights: Vec<LightDesc>) -> Scene {
         geometry: GeometryDesc::Rectangle,
         material: "wall".into(),
         emission: None,
+        emission_texture: None,
         transform: Mat4::from_rotation_x(-PI / 2.0) * Mat4::from_scale(Vec3::splat(10.0)),
         flip_normals: false,
         span: Span::code(),
@@ -480,8 +481,12 @@ fn ies_shaped_triangle_light_is_unbiased_and_scaled_by_the_profile() {
     let le = Vec3::splat(2.0);
     let tri = TriangleLight::new(p, n, le).with_profile(profile.clone(), projected);
     let w = Vec3::new(0.3, -1.0, 0.2).normalize();
-    assert_close(tri.radiance(n, w), le * profile.relative(w), "radiance");
-    assert_eq!(tri.radiance(n, -w), Vec3::ZERO);
+    assert_close(
+        tri.radiance(n, Vec2::ZERO, w),
+        le * profile.relative(w),
+        "radiance",
+    );
+    assert_eq!(tri.radiance(n, Vec2::ZERO, -w), Vec3::ZERO);
     let expected_power = tri.area * 2.0 * projected;
     assert!((tri.power() - expected_power).abs() < 1e-5 * expected_power);
     assert!(projected > 0.0 && projected < PI);

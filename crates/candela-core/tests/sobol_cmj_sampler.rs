@@ -284,6 +284,7 @@ fn lamp_over_floor(lens: bool) -> SceneDesc {
             geometry: quad(corners),
             material: "white".into(),
             emission,
+            emission_texture: None,
             transform: Mat4::IDENTITY,
             flip_normals: false,
             span: Span::code(),

@@ -115,6 +115,7 @@ fn shape(mesh: MeshDesc, material: &str, emission: Option<Vec3>, span: &Span) ->
         geometry: GeometryDesc::Mesh(Arc::new(mesh)),
         material: material.into(),
         emission,
+        emission_texture: None,
         transform: Mat4::IDENTITY,
         flip_normals: false,
         span: span.clone(),

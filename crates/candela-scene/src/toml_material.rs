@@ -29,14 +29,14 @@ pub(crate) const MATERIAL_TYPES: &[&str] = &[
 
 /// A texturable value: one number, `[r, g, b]`, or a texture table.
 #[derive(Debug)]
-enum TexValue {
+pub(crate) enum TexValue {
     Value(Vec3),
     Table(TexTable),
 }
 
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
-struct TexTable {
+pub(crate) struct TexTable {
     #[serde(rename = "type")]
     kind: TexKind,
     file: Option<Spanned<String>>,
@@ -145,7 +145,7 @@ struct MaterialEntry {
 
 /// Whether a texture slot holds colour (sRGB-decoded by default) or data (linear).
 #[derive(Clone, Copy, PartialEq)]
-enum Slot {
+pub(crate) enum Slot {
     Color,
     Data,
 }
@@ -320,7 +320,7 @@ fn scalar_eta(src: &Source, eta: Option<Spanned<Splat3>>) -> Result<f32, LoadErr
     Ok(v.x)
 }
 
-fn texture(
+pub(crate) fn texture(
     src: &Source,
     base: &Path,
     v: Spanned<TexValue>,

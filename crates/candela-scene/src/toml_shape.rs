@@ -4,13 +4,14 @@ use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
-use candela_core::desc::{GeometryDesc, MeshDesc, ShapeDesc, Span};
+use candela_core::desc::{GeometryDesc, MeshDesc, ShapeDesc, Span, TextureDesc};
 use candela_core::photometry::GoniometricTable;
 use glam::{Mat4, Vec3, Vec4};
 use serde::de::IgnoredAny;
 use serde::Deserialize;
 use toml::Spanned;
 
+use crate::toml_material::{texture, Slot, TexValue};
 use crate::toml_scene::{deserialize, item_type, Item};
 use crate::toml_values::{Num, NumArray, Splat3, V2, V3};
 use crate::{load_mesh, LoadError, Source};
@@ -94,7 +95,7 @@ pub(crate) fn compose(src: &Source, ops: Vec<Spanned<TransformOp>>) -> Result<Ma
 /// combine with `deny_unknown_fields`.
 struct Common {
     material: String,
-    emission: Option<Splat3>,
+    emission: Option<Spanned<TexValue>>,
     ies: Option<Spanned<String>>,
     flip_normals: Option<bool>,
     transform: Option<Vec<Spanned<TransformOp>>>,
@@ -111,7 +112,7 @@ struct MeshEntry {
     normals: Option<Spanned<Vec<V3>>>,
     uvs: Option<Spanned<Vec<V2>>>,
     material: String,
-    emission: Option<Splat3>,
+    emission: Option<Spanned<TexValue>>,
     ies: Option<Spanned<String>>,
     flip_normals: Option<bool>,
     transform: Option<Vec<Spanned<TransformOp>>>,
@@ -127,7 +128,7 @@ struct SphereEntry {
     center: Option<V3>,
     radius: Option<Num>,
     material: String,
-    emission: Option<Splat3>,
+    emission: Option<Spanned<TexValue>>,
     ies: Option<Spanned<String>>,
     flip_normals: Option<bool>,
     transform: Option<Vec<Spanned<TransformOp>>>,
@@ -140,7 +141,7 @@ struct PrimitiveEntry {
     #[serde(rename = "type")]
     _kind: IgnoredAny,
     material: String,
-    emission: Option<Splat3>,
+    emission: Option<Spanned<TexValue>>,
     ies: Option<Spanned<String>>,
     flip_normals: Option<bool>,
     transform: Option<Vec<Spanned<TransformOp>>>,
@@ -254,10 +255,19 @@ pub(crate) fn parse_shape(
             src.span(file.span().start),
         )),
     };
+    // A constant emission is the radiance; a texture multiplies a radiance of one.
+    let (emission, emission_texture) = match common.emission {
+        None => (None, None),
+        Some(v) => match texture(src, base, v, Slot::Color)? {
+            TextureDesc::Constant(c) => (Some(c), None),
+            t => (Some(Vec3::ONE), Some(t)),
+        },
+    };
     let shape = ShapeDesc {
         geometry,
         material: common.material,
-        emission: common.emission.map(|c| c.0),
+        emission,
+        emission_texture,
         transform: compose(src, common.transform.unwrap_or_default())?,
         flip_normals: common.flip_normals.unwrap_or(false),
         span: src.span(at),

@@ -997,3 +997,94 @@ fn scenes_without_nodes_load() {
     let e = parse(&g).unwrap_err();
     assert!(e.contains("invalid glTF JSON"), "{e}");
 }
+
+#[test]
+fn an_emissive_texture_makes_a_textured_area_light() {
+    // A quad filling the view, emissive factor 2 × a 2 × 1 texture (white | black, clamped):
+    // bilinear between the texel centres at u = ¼ and ¾, so the radiance is 2 left of
+    // u = ¼, 0 right of ¾ and linear between. The camera sees u ∈ [0, 1] across 8 columns;
+    // a column's mean is the texture's mean over it (up to where its 64 samples fall in
+    // the pixel: 0.02 covers that). Before, the texture became its mean, 1, everywhere.
+    let mut g = Glb::new();
+    let tex = g.texture(
+        &png(2, 1, |x, _| if x == 0 { [255; 4] } else { [0, 0, 0, 255] }),
+        Some(json!({"wrapS": 33071, "wrapT": 33071})),
+    );
+    let m = g.material(json!({"emissiveFactor": [2.0, 2.0, 2.0],
+        "emissiveTexture": {"index": tex},
+        "pbrMetallicRoughness": {"baseColorFactor": [0.0, 0.0, 0.0, 1.0]}}));
+    let q = g.quad(m);
+    let mesh = g.mesh(vec![q]);
+    g.node(json!({ "mesh": mesh }), true);
+    let yfov = 2.0 * (1.0f32 / 3.0).atan();
+    g.json["cameras"] = json!([{"type": "perspective",
+        "perspective": {"yfov": yfov, "aspectRatio": 1.0, "znear": 0.1}}]);
+    g.node(json!({"camera": 0, "translation": [0.0, 0.0, 3.0]}), true);
+    let loaded = parse(&g).unwrap();
+    assert!(
+        loaded.warnings.iter().all(|w| !w.contains("emissive")),
+        "{:?}",
+        loaded.warnings
+    );
+    let mut desc = loaded.desc;
+    assert!(desc.shapes[0].emission_texture.is_some());
+    desc.render.width = 8;
+    desc.render.height = 8;
+    desc.render.spp = 64;
+    desc.render.max_depth = 0;
+    let scene = candela_core::build::build(&desc).unwrap();
+    let r = candela_core::integrator::render(&scene, 0..64, &AtomicBool::new(false), &|_| {});
+    let px = r.film.resolve();
+    let column = |i: usize| (0..8).map(|j| px[j * 8 + i].x).sum::<f32>() / 8.0;
+    let want = |i: usize| {
+        // The texture's mean over u ∈ [i/8, (i + 1)/8], by a fine midpoint sum.
+        (0..1000)
+            .map(|k| {
+                let u = (i as f32 + (k as f32 + 0.5) / 1000.0) / 8.0;
+                2.0 * ((0.75 - u) / 0.5).clamp(0.0, 1.0)
+            })
+            .sum::<f32>()
+            / 1000.0
+    };
+    for i in 0..8 {
+        assert!(
+            (column(i) - want(i)).abs() < 0.02,
+            "column {i}: {} vs {}",
+            column(i),
+            want(i)
+        );
+    }
+}
+
+#[test]
+fn partial_transmission_mixes_the_glass_in() {
+    // KHR_materials_transmission t mixes the dielectric into the metallic-roughness BSDF
+    // by t·(1 − metallic); t = 1 without a texture is the dielectric alone.
+    for (t, metallic, want) in [
+        (0.4f32, 0.5f32, Some(0.2f32)),
+        (0.3, 0.0, Some(0.3)),
+        (1.0, 0.0, None),
+    ] {
+        let mut g = Glb::one_quad();
+        g.json["materials"][0] = json!({
+            "pbrMetallicRoughness": {"metallicFactor": metallic, "roughnessFactor": 0.5},
+            "extensions": {"KHR_materials_transmission": {"transmissionFactor": t}}});
+        g.json["extensionsUsed"] = json!(["KHR_materials_transmission"]);
+        let desc = parse(&g).unwrap().desc;
+        match (&desc.materials[0].bsdf, want) {
+            (BsdfDesc::Mix { weight, a, b }, Some(w)) => {
+                let TextureDesc::Constant(c) = weight else {
+                    panic!("{weight:?}")
+                };
+                assert!((c.x - w).abs() < 1e-6, "t {t}: weight {c}");
+                assert!(matches!(**a, BsdfDesc::MetalRough { .. }));
+                let BsdfDesc::Dielectric { alpha_u, .. } = **b else {
+                    panic!("{b:?}")
+                };
+                assert_eq!(alpha_u, 0.25);
+            }
+            (BsdfDesc::Dielectric { .. }, None) => {}
+            (other, _) => panic!("t {t}: {other:?}"),
+        }
+    }
+}

@@ -46,7 +46,7 @@ fn film_bits(file: &str, isa: Isa) -> (Vec<u64>, u64) {
     (bits, result.stats.rays)
 }
 
-const SCENES: [&str; 12] = [
+const SCENES: [&str; 13] = [
     "cornell.toml",
     "glass_sphere.toml",
     "rough_metals.toml",
@@ -56,6 +56,7 @@ const SCENES: [&str; 12] = [
     "mix.toml",
     "dof.toml",
     "ies-room.toml",
+    "textured-light.toml",
     "environment.toml",
     "many_lights.toml",
     "gltf/spheres.gltf",

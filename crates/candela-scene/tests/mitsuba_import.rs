@@ -1156,3 +1156,31 @@ fn orthographic_rays_match_mitsubas() {
     ));
     assert!(e.contains("scene.xml:2:1:") && e.contains("square"), "{e}");
 }
+
+#[test]
+fn textured_disks_carry_mitsubas_polar_uvs() {
+    // Mitsuba 3.9.1's disk: a hit at (x, y) has uv (r, atan2(y, x)/2π in [0, 1)):
+    //   sc.ray_intersect(mi.Ray3f([x, y, 1], [0, 0, -1])).uv
+    // Candela's own disk maps uvs flat, so a textured one becomes a fan with these uvs; r
+    // and φ interpolate linearly over each of its 128 triangles, to within 10⁻³ (u) and
+    // half of 1/256 of the way round (v) near the centre.
+    let desc = load(&scene(
+        r#"<shape type="disk"><bsdf type="diffuse"><texture type="checkerboard" name="reflectance"/></bsdf></shape>
+           <shape type="disk"><transform name="to_world"><translate z="-5"/></transform></shape>"#,
+    ));
+    assert!(matches!(desc.shapes[0].geometry, GeometryDesc::Mesh(_)));
+    assert!(matches!(desc.shapes[1].geometry, GeometryDesc::Disk));
+    let scene = candela_core::build::build(&desc).unwrap();
+    for (x, y, u, v) in [
+        (0.0, 0.5, 0.5, 0.25),
+        (-0.3, -0.4, 0.5, 0.647584),
+        (0.2, -0.6, 0.632456, 0.801208),
+        (0.7, 0.1, std::f32::consts::FRAC_1_SQRT_2, 0.0225836),
+        (0.05, 0.9, 0.901388, 0.241167),
+    ] {
+        let ray = Ray::new(Vec3::new(x, y, 1.0), Vec3::NEG_Z);
+        let si = scene.intersect(&ray, f32::INFINITY).expect("a hit");
+        assert!((si.uv.x - u).abs() < 1e-3, "({x}, {y}): {}", si.uv);
+        assert!((si.uv.y - v).abs() < 2e-3, "({x}, {y}): {}", si.uv);
+    }
+}

@@ -9,7 +9,7 @@ use candela_core::build::build;
 use candela_core::desc::*;
 use candela_core::light::Light;
 use candela_scene::{load_scene, parse_toml_scene};
-use glam::Vec3;
+use glam::{Vec2, Vec3};
 
 /// A tiny rotationally symmetric IES file (LM-63-2002): 100 cd at the nadir, 0 at 90°.
 const IES: &str = "IESNA:LM-63-2002\n[TEST] t\nTILT=NONE\n1 -1 1 3 1 1 2 0 0 0\n1 1 10\n\
@@ -140,14 +140,14 @@ fn ies_on_an_emitting_shape_shapes_its_triangles() {
         let Light::Triangle(t) = l else { panic!() };
         // Along the normal the profile is at its peak; at 45° it is half.
         assert!(
-            (t.radiance(Vec3::Z, Vec3::Z) - Vec3::splat(2.0))
+            (t.radiance(Vec3::Z, Vec2::ZERO, Vec3::Z) - Vec3::splat(2.0))
                 .abs()
                 .max_element()
                 < 1e-4
         );
         let w = Vec3::new(1.0, 0.0, 1.0).normalize();
         assert!(
-            (t.radiance(Vec3::Z, w) - Vec3::splat(1.0))
+            (t.radiance(Vec3::Z, Vec2::ZERO, w) - Vec3::splat(1.0))
                 .abs()
                 .max_element()
                 < 1e-3
@@ -234,4 +234,60 @@ fn the_ies_room_example_loads_and_builds() {
         .lights
         .iter()
         .any(|l| matches!(l, Light::Triangle(t) if t.profile.is_some())));
+}
+
+#[test]
+fn emission_takes_a_texture() {
+    let (_d, s) = assets();
+    // A colour stays the radiance.
+    let desc = load(
+        &s,
+        "[[shape]]\ntype = \"rectangle\"\nmaterial = \"white\"\nemission = 3\n",
+    )
+    .unwrap();
+    assert_eq!(desc.shapes[0].emission, Some(Vec3::splat(3.0)));
+    assert!(desc.shapes[0].emission_texture.is_none());
+    // An image (sRGB-decoded, as a colour slot) multiplies a radiance of one.
+    let desc = load(
+        &s,
+        "[[shape]]\ntype = \"rectangle\"\nmaterial = \"white\"\n\
+         emission = { type = \"image\", file = \"img.png\", scale = 4 }\n",
+    )
+    .unwrap();
+    assert_eq!(desc.shapes[0].emission, Some(Vec3::ONE));
+    let Some(TextureDesc::Image(t)) = &desc.shapes[0].emission_texture else {
+        panic!("{:?}", desc.shapes[0].emission_texture)
+    };
+    assert_eq!(t.scale, Vec3::splat(4.0));
+    assert!(
+        (t.image.pixels[0].x - 0.2158605).abs() < 1e-5,
+        "{}",
+        t.image.pixels[0]
+    );
+    let scene = build(&desc).unwrap();
+    // Textured triangles stay apart (no parallelogram), each with the texture.
+    assert_eq!(scene.lights.len(), 2);
+    for l in &scene.lights {
+        let Light::Triangle(t) = l else {
+            panic!("{l:?}")
+        };
+        assert!(t.texture.is_some());
+    }
+    // A checker too; spheres refuse a texture, at the shape.
+    let sphere = "[[shape]]\ntype = \"sphere\"\nmaterial = \"white\"\n\
+                  emission = { type = \"checker\", a = 2, b = 0 }\n";
+    let err = build(&load(&s, sphere).unwrap()).unwrap_err().to_string();
+    assert!(
+        err.contains("scene.toml:4:1") && err.contains("not supported on spheres"),
+        "{err}"
+    );
+    let err = load(
+        &s,
+        "[[shape]]\ntype = \"disk\"\nmaterial = \"white\"\nemission = { type = \"image\" }\n",
+    )
+    .unwrap_err();
+    assert!(
+        err.contains("scene.toml:7:12") && err.contains("needs `file`"),
+        "{err}"
+    );
 }

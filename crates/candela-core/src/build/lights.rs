@@ -12,8 +12,9 @@
 //! - the profile's own candela: `c`/Y(`c`) · I_max / 683.
 
 use std::f32::consts::PI;
+use std::sync::Arc;
 
-use glam::Vec3;
+use glam::{Vec2, Vec3};
 
 use super::{build_texture, check_color, check_finite, check_image, err, BuildError};
 use crate::desc::{
@@ -22,11 +23,12 @@ use crate::desc::{
 };
 use crate::light::blackbody::blackbody_rgb;
 use crate::light::{
-    DirectionalLight, GoniometricLight, Light, LightId, LightProfile, ParallelogramLight,
-    PointLight, ProjectorLight, SpotLight, TriangleLight,
+    DirectionalLight, EmissionTexture, GoniometricLight, Light, LightId, LightProfile,
+    ParallelogramLight, PointLight, ProjectorLight, SpotLight, TriangleLight,
 };
 use crate::math::luminance;
 use crate::scene::Mesh;
+use crate::texture::Texture;
 
 /// Lumens per watt at 555 nm, the definition of the candela.
 pub const LUMENS_PER_WATT: f32 = 683.0;
@@ -287,16 +289,19 @@ pub(super) fn check_emission_profiles(desc: &SceneDesc) -> Result<(), BuildError
 }
 
 /// One light per triangle of the world-space `mesh` of shape `shape_index` (one per
-/// quad where two consecutive unshaped triangles tile a parallelogram), emitting
-/// `le`, shaped by the shape's IES profile if it has one (nadir along each triangle's
-/// normal, C0 along the shape's transformed local +x).
+/// quad where two consecutive unshaped, untextured triangles tile a parallelogram),
+/// emitting `le` times `texture` at the mesh's uvs, shaped by the shape's IES profile if
+/// it has one (nadir along each triangle's normal, C0 along the shape's transformed
+/// local +x).
 pub(super) fn triangle_lights(
     desc: &SceneDesc,
     shape_index: usize,
     mesh: &mut Mesh,
     le: Vec3,
+    texture: Option<&Arc<Texture>>,
     lights: &mut Vec<Light>,
 ) {
+    let floor = texture.map(|t| t.mean());
     let table = desc
         .emission_profiles
         .iter()
@@ -315,7 +320,13 @@ pub(super) fn triangle_lights(
         let mut light = TriangleLight::new(mesh.vertices(tri), n, le);
         // A quad's two triangles (consecutive, as loaders triangulate quads) become one
         // parallelogram light, whose 2D samples are stratified over the whole quad.
-        if table.is_none() && tri + 1 < count {
+        if let (Some(t), Some(floor)) = (texture, floor) {
+            // The corners' uvs as `Mesh::uv_at` interpolates them (barycentrics where the
+            // mesh has none).
+            let uv = [Vec2::ZERO, Vec2::X, Vec2::Y].map(|b| mesh.uv_at(tri, b));
+            light = light.with_texture(EmissionTexture::new(t.clone(), uv, floor));
+        }
+        if table.is_none() && texture.is_none() && tri + 1 < count {
             let next =
                 TriangleLight::new(mesh.vertices(tri + 1), mesh.geometric_normal(tri + 1), le);
             if let Some(quad) = ParallelogramLight::from_triangles(&light, &next) {

@@ -36,7 +36,7 @@ pub use profile::LightProfile;
 pub use projector::ProjectorLight;
 pub use sphere::SphereLight;
 pub use spot::SpotLight;
-pub use triangle::TriangleLight;
+pub use triangle::{EmissionTexture, TriangleLight};
 
 use glam::{Vec2, Vec3};
 
@@ -191,9 +191,10 @@ impl Light {
         }
     }
 
-    /// Radiance leaving an area light at a point with geometric normal `n` in direction `w`.
+    /// Radiance leaving an area light at a point with geometric normal `n` and texture
+    /// coordinates `uv` in direction `w`.
     #[inline]
-    pub fn radiance(&self, n: Vec3, w: Vec3) -> Vec3 {
+    pub fn radiance(&self, n: Vec3, uv: Vec2, w: Vec3) -> Vec3 {
         match self {
             Light::Point(_)
             | Light::Spot(_)
@@ -201,7 +202,7 @@ impl Light {
             | Light::Directional(_)
             | Light::Projector(_)
             | Light::Environment(_) => Vec3::ZERO,
-            Light::Triangle(l) => l.radiance(n, w),
+            Light::Triangle(l) => l.radiance(n, uv, w),
             Light::Parallelogram(l) => l.radiance(n, w),
             Light::Sphere(l) => l.radiance(n, w),
         }

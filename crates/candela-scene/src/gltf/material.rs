@@ -4,16 +4,18 @@
 //!   roughness = factors × the B and G channels of their texture (linear).
 //! - Normal texture: linear, its `scale` baked into the image's x and y
 //!   ((2c − 1)·scale, clamped to [−1, 1] where scale > 1).
-//! - Emission: `emissiveFactor` × KHR_materials_emissive_strength, read as radiance in
-//!   W·sr⁻¹·m⁻² (linear Rec.709). Emission is constant over a shape, so an emissive texture
-//!   contributes its mean value (with a warning).
+//! - Emission: `emissiveFactor` × KHR_materials_emissive_strength × the emissive texture
+//!   (sRGB-decoded), read as radiance in W·sr⁻¹·m⁻² (linear Rec.709): a textured area
+//!   light.
 //! - Occlusion textures are ignored: a path tracer computes occlusion itself.
 //! - Alpha: `MASK` and `BLEND` wrap the BSDF in [`BsdfDesc::Alpha`] with α = base colour
 //!   alpha factor × texture alpha.
-//! - KHR_materials_transmission with factor ≥ ½ makes a rough dielectric of index
-//!   KHR_materials_ior (default 1.5) and α = roughness², its transmission tinted by the
-//!   base colour (factor × texture, times vertex colours); partial factors are not
-//!   modelled (warned).
+//! - KHR_materials_transmission makes a rough dielectric of index KHR_materials_ior
+//!   (default 1.5) and α = roughness², its transmission tinted by the base colour (factor
+//!   × texture, times vertex colours). A partial transmission t (the factor × the red
+//!   channel of its texture) mixes it with the metallic-roughness BSDF by t·(1 − metallic)
+//!   ([`BsdfDesc::Mix`]): the extension's model for a dielectric. Where metallic comes
+//!   from a texture, t is not scaled by it.
 //! - `doubleSided` wraps the BSDF in [`BsdfDesc::TwoSided`]; Candela's BSDFs reflect on
 //!   both sides either way (a path tracer does not cull back faces).
 //! - Samplers: wrap S (T must agree, else a warning) as the texture's wrap mode; lookups
@@ -39,6 +41,8 @@ use crate::LoadError;
 pub(crate) struct MaterialInfo {
     pub name: String,
     pub emission: Option<Vec3>,
+    /// The emissive texture, multiplying `emission`.
+    pub emission_texture: Option<TextureDesc>,
     /// The TEXCOORD set the material's textures read.
     pub tex_coord: u32,
     pub has_normal_map: bool,
@@ -86,6 +90,7 @@ impl Materials {
             .base_color_texture()
             .map(|t| tex_coord(&t))
             .or_else(|| pbr.metallic_roughness_texture().map(|t| tex_coord(&t)))
+            .or_else(|| m.emissive_texture().map(|t| tex_coord(&t)))
             .unwrap_or(0);
         let [r, g, b, a] = pbr.base_color_factor();
         let base_factor = Vec3::new(r, g, b);
@@ -120,18 +125,9 @@ impl Materials {
             ),
         };
         let transmission = m.transmission().map_or(0.0, |t| t.transmission_factor());
+        let transmission_texture = m.transmission().and_then(|t| t.transmission_texture());
         let ior = m.ior().unwrap_or(1.5);
-        let mut bsdf = if transmission >= 0.5 {
-            if transmission < 1.0 {
-                ctx.warn(format!(
-                    "{path}: transmission {transmission} is taken as 1 (no partial transmission)"
-                ));
-            }
-            if m.transmission()
-                .is_some_and(|t| t.transmission_texture().is_some())
-            {
-                ctx.warn(format!("{path}: transmission texture ignored (taken as 1)"));
-            }
+        let glass = || {
             let alpha = pbr.roughness_factor().clamp(0.0, 1.0).powi(2);
             BsdfDesc::Dielectric {
                 eta: ior,
@@ -139,24 +135,46 @@ impl Materials {
                 alpha_v: alpha,
                 distribution: MicrofacetDesc::Ggx,
                 thin: false,
-                tint: base_color,
+                tint: base_color.clone(),
             }
+        };
+        let opaque = || BsdfDesc::MetalRough {
+            base_color: base_color.clone(),
+            metallic: metallic.clone(),
+            roughness: roughness.clone(),
+        };
+        if transmission <= 0.0 && (ior - 1.5).abs() > 1e-6 {
+            ctx.warn(format!(
+                "{path}: ior {ior} only affects transmission; the metallic-roughness model \
+                 keeps F0 = 0.04"
+            ));
+        }
+        let mut bsdf = if transmission <= 0.0 {
+            opaque()
+        } else if transmission >= 1.0 && transmission_texture.is_none() {
+            glass()
         } else {
-            if transmission > 0.0 {
-                ctx.warn(format!(
-                    "{path}: transmission {transmission} below 0.5 is taken as 0"
-                ));
-            }
-            if (ior - 1.5).abs() > 1e-6 {
-                ctx.warn(format!(
-                    "{path}: ior {ior} only affects transmissive materials; the \
-                     metallic-roughness model keeps F0 = 0.04"
-                ));
-            }
-            BsdfDesc::MetalRough {
-                base_color,
-                metallic,
-                roughness,
+            // The extension's dielectric is mix(diffuse, transmission, t) under the same
+            // Fresnel-weighted specular layer. Mixing the whole metallic-roughness BSDF
+            // with the glass by t gives exactly that for a dielectric, up to Schlick's F
+            // against the glass's exact one. Metals do not transmit, so t is scaled by
+            // 1 − metallic (exact at metallic 0 and 1) where metallic is a factor alone;
+            // a metallic texture is not looked up for it.
+            let opacity = match pbr.metallic_roughness_texture() {
+                Some(_) => 1.0,
+                None => 1.0 - pbr.metallic_factor().clamp(0.0, 1.0),
+            };
+            let w = transmission.min(1.0) * opacity;
+            let weight = match &transmission_texture {
+                Some(t) => {
+                    self.texture(ctx, &path, t, Use::Data, Vec3::splat(w), Some(0), tex_coord)?
+                }
+                None => TextureDesc::Constant(Vec3::splat(w)),
+            };
+            BsdfDesc::Mix {
+                weight,
+                a: Box::new(opaque()),
+                b: Box::new(glass()),
             }
         };
         let normal = m.normal_texture();
@@ -223,20 +241,18 @@ impl Materials {
             bsdf = BsdfDesc::TwoSided(Box::new(bsdf));
         }
         let strength = m.emissive_strength().unwrap_or(1.0);
-        let mut emission = Vec3::from(m.emissive_factor()) * strength;
-        if let Some(t) = m.emissive_texture() {
-            let img = self.image(ctx, &path, &t.texture(), Use::Color)?;
-            let mean = img.pixels.iter().copied().sum::<Vec3>() / img.pixels.len().max(1) as f32;
-            ctx.warn(format!(
-                "{path}: emissive texture replaced by its mean {mean} (emission is constant \
-                 over a shape)"
-            ));
-            emission *= mean;
-        }
+        let emission = Vec3::from(m.emissive_factor()) * strength;
+        let emission_texture = match m.emissive_texture() {
+            Some(t) if emission != Vec3::ZERO => {
+                Some(self.texture(ctx, &path, &t, Use::Color, Vec3::ONE, None, tex_coord)?)
+            }
+            _ => None,
+        };
         let has_normal_map = normal.is_some();
         let info = MaterialInfo {
             name: name.clone(),
             emission: (emission != Vec3::ZERO).then_some(emission),
+            emission_texture,
             tex_coord,
             has_normal_map,
         };

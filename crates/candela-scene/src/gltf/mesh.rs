@@ -69,6 +69,7 @@ pub(crate) fn place_mesh(
                 geometry: GeometryDesc::Mesh(desc),
                 material: mat.name.clone(),
                 emission: mat.emission,
+                emission_texture: mat.emission_texture.clone(),
                 transform: world,
                 flip_normals,
                 span: ctx.span(),

@@ -1,7 +1,7 @@
 //! `<shape>`: Mitsuba's primitives map to Candela's unit primitives, which follow the
 //! same conventions (rectangle [-1,1]² and disk of radius 1 in z = 0 facing +z, cube
-//! [-1,1]³); `obj` and `ply` go through [`crate::load_mesh`]. A textured `sphere`
-//! becomes a mesh carrying Mitsuba's sphere uvs (see [`uv_sphere`]).
+//! [-1,1]³); `obj` and `ply` go through [`crate::load_mesh`]. A textured `sphere` or
+//! `disk` becomes a mesh carrying Mitsuba's uvs (see [`uv_sphere`], [`polar_disk`]).
 
 use std::sync::Arc;
 
@@ -165,20 +165,9 @@ fn shape_desc(ctx: &mut Ctx, node: &Node) -> Result<Option<ShapeDesc>, LoadError
     let transform = to_world(node)?;
     let flip_normals = node.boolean("flip_normals")?.unwrap_or(false);
     let material = material(ctx, node)?;
-    let geometry = match geometry {
-        GeometryDesc::Sphere { center, radius } if reads_uv(ctx, &material) => {
-            GeometryDesc::Mesh(Arc::new(uv_sphere(center, radius)))
-        }
-        g => g,
-    };
-    let geometry = match geometry {
-        GeometryDesc::Mesh(m) if normal_mapped(ctx, &material) && m.tangents.is_empty() => {
-            GeometryDesc::Mesh(Arc::new(with_tangents(&m)))
-        }
-        g => g,
-    };
 
     let mut emission = None;
+    let mut emission_texture = None;
     for e in node.plugins("emitter") {
         if e.kind() != "area" {
             ctx.unsupported(
@@ -190,14 +179,40 @@ fn shape_desc(ctx: &mut Ctx, node: &Node) -> Result<Option<ShapeDesc>, LoadError
         if emission.is_some() {
             return Err(e.error("a shape has at most one area emitter"));
         }
-        emission = Some(e.illuminant("radiance")?.unwrap_or(Vec3::ONE));
+        // A texture (a bitmap or a checkerboard, nested or by `<ref>`) makes a textured
+        // area light: Candela's emission texture, read at the shape's uvs.
+        let textured = e
+            .children
+            .iter()
+            .any(|c| c.name() == "radiance" && matches!(c.tag.as_str(), "texture" | "ref"));
+        if textured {
+            emission = Some(Vec3::ONE);
+            emission_texture = Some(ctx.texture(e, "radiance", Vec3::ONE)?);
+        } else {
+            emission = Some(e.illuminant("radiance")?.unwrap_or(Vec3::ONE));
+        }
         ctx.check_unused(e)?;
     }
+    let textured = reads_uv(ctx, &material) || emission_texture.is_some();
+    let geometry = match geometry {
+        GeometryDesc::Sphere { center, radius } if textured => {
+            GeometryDesc::Mesh(Arc::new(uv_sphere(center, radius)))
+        }
+        GeometryDesc::Disk if textured => GeometryDesc::Mesh(Arc::new(polar_disk())),
+        g => g,
+    };
+    let geometry = match geometry {
+        GeometryDesc::Mesh(m) if normal_mapped(ctx, &material) && m.tangents.is_empty() => {
+            GeometryDesc::Mesh(Arc::new(with_tangents(&m)))
+        }
+        g => g,
+    };
     ctx.check_unused(node)?;
     Ok(Some(ShapeDesc {
         geometry,
         material,
         emission,
+        emission_texture,
         transform,
         flip_normals,
         span: node.span.clone(),
@@ -377,6 +392,36 @@ fn cylinder(node: &Node) -> Result<MeshDesc, LoadError> {
         mesh.indices.push([a, c, d]);
     }
     Ok(mesh)
+}
+
+/// Triangles of [`polar_disk`], as Candela's own disk.
+const DISK_SEGMENTS: u32 = 128;
+
+/// The unit disk in z = 0 facing +z with Mitsuba's polar uvs: `disk.cpp` gives a point at
+/// radius r and angle φ = atan2(y, x) the uv (r, φ/2π), φ in [0, 2π). Candela's disk
+/// primitive maps uvs flat, so a textured disk is this fan instead. Each triangle has its
+/// own centre vertex at u = 0 with its rim's v, so v runs from 0 to 1 around without a
+/// seam across the fan; linear interpolation over a triangle reads r and φ to ~10⁻⁴.
+pub(crate) fn polar_disk() -> MeshDesc {
+    let mut mesh = MeshDesc::default();
+    let n = DISK_SEGMENTS;
+    for j in 0..n {
+        let (v0, v1) = (j as f32 / n as f32, (j + 1) as f32 / n as f32);
+        let rim = |v: f32| {
+            let phi = v * std::f32::consts::TAU;
+            Vec3::new(phi.cos(), phi.sin(), 0.0)
+        };
+        let base = mesh.positions.len() as u32;
+        mesh.positions.extend([Vec3::ZERO, rim(v0), rim(v1)]);
+        mesh.uvs.extend([
+            Vec2::new(0.0, 0.5 * (v0 + v1)),
+            Vec2::new(1.0, v0),
+            Vec2::new(1.0, v1),
+        ]);
+        mesh.normals.extend([Vec3::Z; 3]);
+        mesh.indices.push([base, base + 1, base + 2]);
+    }
+    mesh
 }
 
 /// Rings from pole to pole and segments around the axis of [`uv_sphere`]: the flat
