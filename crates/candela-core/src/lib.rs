@@ -18,6 +18,7 @@
 //!     geometry: GeometryDesc::Sphere { center: Vec3::ZERO, radius: 1.0 },
 //!     material: "white".into(),
 //!     emission: Some(Vec3::ONE),
+//!     emission_texture: None,
 //!     transform: Mat4::IDENTITY,
 //!     flip_normals: false,
 //!     span: Span::code(),

@@ -355,6 +355,28 @@ fn sphere_enclosure_around_a_black_emitter_conserves_energy() {
     }
 }
 
+/// A camera at `target` + `offset` looking at `target` through a footprint ~10⁻³ wide:
+/// the radiance of the scenes below varies over it by ~10⁻⁶ relative.
+fn narrow_camera(target: Vec3, offset: Vec3) -> CameraDesc {
+    CameraDesc {
+        position: target + offset,
+        look_at: target,
+        up: Vec3::Z,
+        fov_y_deg: 0.02,
+        span: Span::code(),
+        ..Default::default()
+    }
+}
+
+/// The plane y = 0, 20 × 20 around the origin, facing +y.
+fn floor_plane(material: &str) -> ShapeDesc {
+    ShapeDesc {
+        transform: Mat4::from_rotation_x(-std::f32::consts::FRAC_PI_2)
+            * Mat4::from_scale(Vec3::splat(10.0)),
+        ..shape(GeometryDesc::Rectangle, material, None, false)
+    }
+}
+
 /// Radiance of a diffuse plane y = 0 (albedo ρ) at `target` on it, lit by a point light
 /// of intensity `intensity` at height `h` over the origin, seen by a narrow camera.
 fn plane_radiance(
@@ -366,15 +388,7 @@ fn plane_radiance(
     sampler: SamplerKind,
 ) -> f64 {
     let mut desc = SceneDesc {
-        camera: CameraDesc {
-            position: target + Vec3::new(0.3, 2.0, 0.2),
-            look_at: target,
-            up: Vec3::Z,
-            // A footprint ~10⁻³ wide: the radiance varies over it by ~10⁻⁶ relative.
-            fov_y_deg: 0.02,
-            span: Span::code(),
-            ..Default::default()
-        },
+        camera: narrow_camera(target, Vec3::new(0.3, 2.0, 0.2)),
         render: RenderSettings {
             width: 4,
             height: 4,
@@ -383,11 +397,7 @@ fn plane_radiance(
         ..Default::default()
     };
     desc.materials.push(material("plane", rho));
-    desc.shapes.push(ShapeDesc {
-        transform: Mat4::from_rotation_x(-std::f32::consts::FRAC_PI_2)
-            * Mat4::from_scale(Vec3::splat(10.0)),
-        ..shape(GeometryDesc::Rectangle, "plane", None, false)
-    });
+    desc.shapes.push(floor_plane("plane"));
     desc.lights.push(LightDesc {
         kind: LightKindDesc::Point {
             position: Vec3::new(0.0, h, 0.0),
@@ -513,24 +523,13 @@ fn a_checkered_emitter_lights_a_plane_square_by_square() {
     let target = Vec3::new(x0 as f32, 0.0, z0 as f32);
     for (mis, sampler) in MIS_MODES.into_iter().flat_map(|m| SAMPLERS.map(|s| (m, s))) {
         let mut desc = SceneDesc {
-            camera: CameraDesc {
-                position: target + Vec3::new(0.1, 0.5, 0.05),
-                look_at: target,
-                up: Vec3::Z,
-                fov_y_deg: 0.02,
-                span: Span::code(),
-                ..Default::default()
-            },
+            camera: narrow_camera(target, Vec3::new(0.1, 0.5, 0.05)),
             render: settings(sampler, mis, 1, 64, 11),
             ..Default::default()
         };
         desc.materials.push(material("plane", rho));
         desc.materials.push(material("black", 0.0));
-        desc.shapes.push(ShapeDesc {
-            transform: Mat4::from_rotation_x(-std::f32::consts::FRAC_PI_2)
-                * Mat4::from_scale(Vec3::splat(10.0)),
-            ..shape(GeometryDesc::Rectangle, "plane", None, false)
-        });
+        desc.shapes.push(floor_plane("plane"));
         desc.shapes.push(ShapeDesc {
             transform: Mat4::from_translation(Vec3::new(0.0, h, 0.0))
                 * Mat4::from_rotation_x(std::f32::consts::FRAC_PI_2)

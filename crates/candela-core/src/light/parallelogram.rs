@@ -58,8 +58,9 @@ impl ParallelogramLight {
     /// The parallelogram the two triangles `a` and `b` tile exactly, if they do: they
     /// share an edge, their other two corners are opposite (the diagonals bisect each
     /// other, to a relative 10⁻⁶ of the size), both emit `le` towards the same normal and
-    /// neither is shaped by a profile or a texture. Then sampling the parallelogram samples the union
-    /// of the triangles, so a ray that hits either finds this light with the same pdf.
+    /// neither is shaped by a profile or a texture. Then sampling the parallelogram
+    /// samples the union of the triangles, so a ray that hits either finds this light with
+    /// the same pdf.
     pub fn from_triangles(a: &TriangleLight, b: &TriangleLight) -> Option<ParallelogramLight> {
         let plain = |t: &TriangleLight| t.profile.is_none() && t.texture.is_none();
         if !plain(a) || !plain(b) || a.le != b.le {

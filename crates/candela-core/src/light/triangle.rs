@@ -22,7 +22,8 @@ use crate::texture::Texture;
 ///
 /// With a `texture` the radiance is `le` × the texture at the point's uv, and the
 /// triangle still samples uniformly by area: light selection weighs the triangle by its
-/// mean radiance (see [`EmissionTexture`]), so a dark part of an image is picked rarely.
+/// mean radiance (see [`EmissionTexture`]), so a triangle over a dark part of an image
+/// is picked rarely.
 #[derive(Clone, Debug)]
 pub struct TriangleLight {
     pub p: [Vec3; 3],
