@@ -392,7 +392,15 @@ fn the_integrator_takes_the_first_direction_at_that_dimension() {
             log: log.clone(),
         };
         let cancel = AtomicBool::new(false);
-        candela_core::integrator::render_with(&scene, recorder, 0..2, &cancel, &|_| {});
+        // One worker: every clone of the recorder appends to the log's last entry, so two
+        // threads would interleave their samples' requests.
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(1)
+            .build()
+            .unwrap();
+        pool.install(|| {
+            candela_core::integrator::render_with(&scene, recorder, 0..2, &cancel, &|_| {})
+        });
         let d = first_direction_dimension(lens);
         let mut want = vec![Event::Pixel(0)];
         if lens {
