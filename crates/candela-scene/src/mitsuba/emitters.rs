@@ -88,10 +88,7 @@ pub(crate) fn emitter(ctx: &mut Ctx, node: &Node) -> Result<(), LoadError> {
 /// I(ω) = π · scale · E(uv) / cos³θ, E looked up as its bitmap is (bilinear, `wrap_mode`).
 /// `None` where `--lenient` skips it.
 fn projector(ctx: &mut Ctx, node: &Node) -> Result<Option<LightKindDesc>, LoadError> {
-    let textured = node
-        .children
-        .iter()
-        .any(|c| c.name() == "irradiance" && matches!(c.tag.as_str(), "texture" | "ref"));
+    let textured = node.is_texture("irradiance");
     let (texture, image) = if textured {
         match ctx.texture(node, "irradiance", Vec3::ONE)? {
             TextureDesc::Image(mut t) => {

@@ -70,6 +70,13 @@ impl Node {
         Some(n)
     }
 
+    /// Whether the property `name` is a texture, nested or by `<ref>` (not a colour).
+    pub fn is_texture(&self, name: &str) -> bool {
+        self.children
+            .iter()
+            .any(|c| c.name() == name && matches!(c.tag.as_str(), "texture" | "ref"))
+    }
+
     /// Child plugins with tag `tag` (`bsdf`, `emitter`, …), marked as used.
     pub fn plugins<'a>(&'a self, tag: &'a str) -> impl Iterator<Item = &'a Node> + 'a {
         self.children

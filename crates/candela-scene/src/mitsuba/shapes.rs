@@ -181,11 +181,7 @@ fn shape_desc(ctx: &mut Ctx, node: &Node) -> Result<Option<ShapeDesc>, LoadError
         }
         // A texture (a bitmap or a checkerboard, nested or by `<ref>`) makes a textured
         // area light: Candela's emission texture, read at the shape's uvs.
-        let textured = e
-            .children
-            .iter()
-            .any(|c| c.name() == "radiance" && matches!(c.tag.as_str(), "texture" | "ref"));
-        if textured {
+        if e.is_texture("radiance") {
             emission = Some(Vec3::ONE);
             emission_texture = Some(ctx.texture(e, "radiance", Vec3::ONE)?);
         } else {
