@@ -1,23 +1,28 @@
 //! Chi-square tests of every sampling routine of the foundation against the density it
-//! claims: the warps, the sphere, triangle and parallelogram lights' `sample_li` against `pdf_li`, the
+//! claims: the warps, the sphere, triangle (plain and textured) and parallelogram lights'
+//! `sample_li` against `pdf_li`, the
 //! diffuse BSDF, and the alias table. Each uses 10⁶ samples and a fixed seed; the suite's
 //! family-wise significance is 0.01, split over its tests by the Šidák correction.
 
 use std::f32::consts::PI;
+use std::sync::Arc;
 
 use candela_core::bsdf::{Bsdf, Diffuse, Lobe};
 use candela_core::chi2::{discrete, sidak_alpha, Chi2Report, ChiSquareTest};
-use candela_core::light::{Light, ParallelogramLight, ShadingCtx, SphereLight, TriangleLight};
+use candela_core::light::{
+    EmissionTexture, Light, ParallelogramLight, ShadingCtx, SphereLight, TriangleLight,
+};
 use candela_core::math::Frame;
 use candela_core::sampler::Pcg32;
 use candela_core::sampling::{
     cosine_hemisphere_pdf, sample_cosine_hemisphere, sample_uniform_cone, sample_uniform_sphere,
     uniform_cone_pdf, AliasTable, UNIFORM_SPHERE_PDF,
 };
-use glam::{Vec2, Vec3};
+use candela_core::texture::Texture;
+use glam::{Affine2, Vec2, Vec3};
 
 /// Number of chi-square tests in this file, for the Šidák correction.
-const TESTS: usize = 24;
+const TESTS: usize = 27;
 
 fn test() -> ChiSquareTest {
     ChiSquareTest {
@@ -161,6 +166,41 @@ fn triangle_light_from_a_point() {
     let r = light_test("triangle light from behind", &light, centroid + n);
     r.assert_passed();
     assert_eq!(r.success_fraction, 0.0);
+}
+
+/// A triangle with a checker emission draws its points where the checker is bright (its
+/// density over its cells, see `EmissionTexture`): the solid-angle density that reaches
+/// the shading point then has the cells' steps in it, and `pdf_li` must find the cell of
+/// the point its ray hits.
+#[test]
+fn textured_triangle_light_from_a_point() {
+    let tri = [
+        Vec3::new(-0.5, 1.0, -0.4),
+        Vec3::new(0.7, 1.2, -0.2),
+        Vec3::new(0.1, 0.9, 0.8),
+    ];
+    let n = (tri[1] - tri[0]).cross(tri[2] - tri[0]).normalize();
+    let checker = Arc::new(Texture::Checker {
+        a: Vec3::new(6.0, 3.0, 1.0),
+        b: Vec3::splat(0.2),
+        uv_transform: Affine2::from_scale(Vec2::splat(3.0)),
+    });
+    let uv = [Vec2::ZERO, Vec2::new(1.0, 0.2), Vec2::new(0.3, 0.9)];
+    let texture = EmissionTexture::new(checker.clone(), uv, Vec3::ONE, checker.mean());
+    let light = Light::Triangle(TriangleLight::new(tri, -n, Vec3::ONE).with_texture(texture));
+    let centroid = (tri[0] + tri[1] + tri[2]) / 3.0;
+    for (what, p) in [
+        ("below", Vec3::new(0.0, 0.0, 0.0)),
+        ("close", centroid - n * 0.05),
+        ("oblique", Vec3::new(2.5, 0.2, 1.5)),
+    ] {
+        light_test(
+            &format!("textured triangle light, {what}, from {p}"),
+            &light,
+            p,
+        )
+        .assert_passed();
+    }
 }
 
 #[test]

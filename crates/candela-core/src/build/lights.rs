@@ -324,7 +324,7 @@ pub(super) fn triangle_lights(
             // The corners' uvs as `Mesh::uv_at` interpolates them (barycentrics where the
             // mesh has none).
             let uv = [Vec2::ZERO, Vec2::X, Vec2::Y].map(|b| mesh.uv_at(tri, b));
-            light = light.with_texture(EmissionTexture::new(t.clone(), uv, floor));
+            light = light.with_texture(EmissionTexture::new(t.clone(), uv, le, floor));
         }
         if table.is_none() && texture.is_none() && tri + 1 < count {
             let next =

@@ -14,6 +14,7 @@
 pub mod blackbody;
 mod bounds;
 mod directional;
+mod emission_texture;
 mod environment;
 pub mod envmap;
 mod goniometric;
@@ -28,6 +29,7 @@ mod triangle;
 
 pub use bounds::{cone_measure, cone_union, ImportanceBounds, LightBounds};
 pub use directional::DirectionalLight;
+pub use emission_texture::EmissionTexture;
 pub use environment::{EnvironmentLight, EnvironmentMap, EnvironmentSampling};
 pub use goniometric::GoniometricLight;
 pub use parallelogram::ParallelogramLight;
@@ -36,7 +38,7 @@ pub use profile::LightProfile;
 pub use projector::ProjectorLight;
 pub use sphere::SphereLight;
 pub use spot::SpotLight;
-pub use triangle::{EmissionTexture, TriangleLight};
+pub use triangle::TriangleLight;
 
 use glam::{Vec2, Vec3};
 

@@ -1,14 +1,12 @@
 use std::f32::consts::PI;
-use std::sync::Arc;
 
 use glam::{Vec2, Vec3};
 
-use super::{flat_importance, LightBounds, LightProfile, LightSample, ShadingCtx};
+use super::{flat_importance, EmissionTexture, LightBounds, LightProfile, LightSample, ShadingCtx};
 use crate::geometry::Aabb;
 use crate::geometry::{Ray, WatertightRay};
 use crate::math::luminance;
 use crate::sampling::sample_uniform_triangle;
-use crate::texture::Texture;
 
 /// One emitting triangle of a mesh. Emits `le` on the side its normal `n` points to.
 /// Sampled uniformly by area; the density is converted to solid angle at the shading
@@ -20,10 +18,11 @@ use crate::texture::Texture;
 /// A · `le` · cos θ · I(ω)/I_max. Sampling stays uniform by area (its density does not
 /// depend on the emitted radiance; only the value does).
 ///
-/// With a `texture` the radiance is `le` × the texture at the point's uv, and the
-/// triangle still samples uniformly by area: light selection weighs the triangle by its
-/// mean radiance (see [`EmissionTexture`]), so a triangle over a dark part of an image
-/// is picked rarely.
+/// With a `texture` the radiance is `le` × the texture at the point's uv. Light selection
+/// weighs the triangle by its mean radiance, so a triangle over a dark part of an image
+/// is picked rarely, and the point on it is drawn where the texture is bright (see
+/// [`EmissionTexture`]): the area density becomes ρ/A, ρ the texture's density there
+/// relative to uniform.
 #[derive(Clone, Debug)]
 pub struct TriangleLight {
     pub p: [Vec3; 3],
@@ -34,47 +33,6 @@ pub struct TriangleLight {
     /// ∫ (radiance / `le`) cos θ dω over the hemisphere: π without a profile.
     pub projected_solid_angle: f32,
     pub texture: Option<EmissionTexture>,
-}
-
-/// The texture of a textured area light's triangle, its corners' uvs, and its mean over
-/// the triangle.
-#[derive(Clone, Debug)]
-pub struct EmissionTexture {
-    pub texture: Arc<Texture>,
-    pub uv: [Vec2; 3],
-    /// The texture's mean over the triangle's area, estimated at build (see
-    /// [`EmissionTexture::new`]): what light selection sees in place of the texture.
-    pub mean: Vec3,
-}
-
-impl EmissionTexture {
-    /// The texture on the triangle with corner uvs `uv`. Its mean is the average of
-    /// k² lookups at stratified points, k from the texels (or checker squares) the
-    /// triangle covers, 1 to 32 a side. Light selection only weighs triangles by it, so it
-    /// needs to be close, not exact. It is kept at least 10⁻³ of `floor` (the texture's
-    /// [`Texture::mean`]) so that no triangle with light in it becomes unselectable
-    /// because its lookups all fell on black.
-    pub fn new(texture: Arc<Texture>, uv: [Vec2; 3], floor: Vec3) -> EmissionTexture {
-        let uv_area = 0.5 * (uv[1] - uv[0]).perp_dot(uv[2] - uv[0]).abs();
-        let k = (uv_area * texture.detail()).sqrt().ceil().clamp(1.0, 32.0) as u32;
-        let mut sum = Vec3::ZERO;
-        for i in 0..k {
-            for j in 0..k {
-                let u = Vec2::new(i as f32 + 0.5, j as f32 + 0.5) / k as f32;
-                let b = sample_uniform_triangle(u);
-                sum += texture.eval(uv[0] * b.x + uv[1] * b.y + uv[2] * b.z);
-            }
-        }
-        let mean = (sum / (k * k) as f32).max(floor * 1e-3);
-        EmissionTexture { texture, uv, mean }
-    }
-
-    /// The texture at barycentrics `b` (weights of the three corners).
-    #[inline]
-    fn at(&self, b: Vec3) -> Vec3 {
-        self.texture
-            .eval(self.uv[0] * b.x + self.uv[1] * b.y + self.uv[2] * b.z)
-    }
 }
 
 impl TriangleLight {
@@ -129,11 +87,18 @@ impl TriangleLight {
     }
 
     pub fn sample_li(&self, ctx: &ShadingCtx, u: Vec2) -> Option<LightSample> {
-        let b = sample_uniform_triangle(u);
+        let Some(texture) = &self.texture else {
+            let b = sample_uniform_triangle(u);
+            let p = self.p[0] * b.x + self.p[1] * b.y + self.p[2] * b.z;
+            return LightSample::uniform_area(ctx.p, p, self.n, self.area, |wi| {
+                self.emitted(Vec3::ONE, -wi)
+            });
+        };
+        // Drawn with density ρ/A: as if uniformly on an area A/ρ.
+        let (b, density) = texture.sample(u);
         let p = self.p[0] * b.x + self.p[1] * b.y + self.p[2] * b.z;
-        LightSample::uniform_area(ctx.p, p, self.n, self.area, |wi| {
-            let tex = self.texture.as_ref().map_or(Vec3::ONE, |t| t.at(b));
-            self.emitted(tex, -wi)
+        LightSample::uniform_area(ctx.p, p, self.n, self.area / density, |wi| {
+            self.emitted(texture.at(b), -wi)
         })
     }
 
@@ -144,7 +109,13 @@ impl TriangleLight {
         }
         let ray = Ray::new(ctx.p, wi);
         match WatertightRay::new(&ray).intersect(self.p[0], self.p[1], self.p[2], f32::INFINITY) {
-            Some(hit) => hit.t * hit.t / (cos_l * self.area),
+            Some(hit) => {
+                let density = self
+                    .texture
+                    .as_ref()
+                    .map_or(1.0, |t| t.density(hit.b1, hit.b2));
+                hit.t * hit.t * density / (cos_l * self.area)
+            }
             None => 0.0,
         }
     }
@@ -209,51 +180,22 @@ pub(super) fn solid_angle(v: [Vec3; 3], len: [f32; 3]) -> f32 {
 
 #[cfg(test)]
 mod tests {
+    use std::sync::Arc;
+
     use glam::Affine2;
 
+    use super::super::emission_texture::tests::checker;
     use super::*;
-
-    fn checker(a: f32, b: f32, scale: f32) -> Arc<Texture> {
-        Arc::new(Texture::Checker {
-            a: Vec3::splat(a),
-            b: Vec3::splat(b),
-            uv_transform: Affine2::from_scale(Vec2::splat(scale)),
-        })
-    }
-
-    /// The triangle uv (0, 0), (1, 0), (0, 1) over a checker of thirds holds 2.5 cells of
-    /// `a` (the three on its diagonal are half inside) and 2 of `b`: mean (2.5a + 2b)/4.5.
-    /// The estimate takes 5² lookups there (36 lookups a unit of uv area), so it is only
-    /// close; 5 % is what its stratified points miss of the cells cut by the diagonal.
-    #[test]
-    fn the_mean_of_an_emission_texture_weighs_its_area() {
-        let uv = [Vec2::ZERO, Vec2::X, Vec2::Y];
-        let t = EmissionTexture::new(checker(4.0, 1.0, 3.0), uv, Vec3::ZERO);
-        let exact = (2.5 * 4.0 + 2.0 * 1.0) / 4.5;
-        assert!(
-            (t.mean.x / exact - 1.0).abs() < 0.05,
-            "{} vs {exact}",
-            t.mean.x
-        );
-        // Inside one cell of `b`: exactly `b`, whatever the number of lookups.
-        let small = [
-            Vec2::new(0.4, 0.1),
-            Vec2::new(0.5, 0.1),
-            Vec2::new(0.4, 0.2),
-        ];
-        let t = EmissionTexture::new(checker(4.0, 1.0, 3.0), small, Vec3::ZERO);
-        assert_eq!(t.mean, Vec3::ONE);
-        // All black: the floor keeps it selectable.
-        let t = EmissionTexture::new(checker(0.0, 0.0, 3.0), uv, Vec3::splat(2.0));
-        assert_eq!(t.mean, Vec3::splat(2e-3));
-    }
+    use crate::desc::{ImageDesc, WrapMode};
+    use crate::sampler::Pcg32;
+    use crate::texture::{ImageTexture, Texture};
 
     /// Light selection sees the texture's mean, and the radiance its value at the point.
     #[test]
     fn a_textured_triangle_emits_its_texture() {
         let p = [Vec3::ZERO, Vec3::X, Vec3::Z];
         let uv = [Vec2::ZERO, Vec2::X, Vec2::Y];
-        let tex = EmissionTexture::new(checker(4.0, 1.0, 2.0), uv, Vec3::ZERO);
+        let tex = EmissionTexture::new(checker(4.0, 1.0, 2.0), uv, Vec3::ONE, Vec3::ZERO);
         let mean = tex.mean;
         let light = TriangleLight::new(p, Vec3::Y, Vec3::splat(0.5)).with_texture(tex);
         let plain = TriangleLight::new(p, Vec3::Y, Vec3::splat(0.5));
@@ -276,7 +218,7 @@ mod tests {
             p: Vec3::new(0.2, 1.0, 0.3),
             n: -Vec3::Y,
         };
-        let mut rng = crate::sampler::Pcg32::new(5, 7);
+        let mut rng = Pcg32::new(5, 7);
         for _ in 0..1000 {
             let u = Vec2::new(rng.uniform_f32(), rng.uniform_f32());
             let s = light.sample_li(&ctx, u).expect("a point in front");
@@ -284,5 +226,77 @@ mod tests {
             let want = 0.5 * light.texture.as_ref().unwrap().texture.eval(uv);
             assert!((s.radiance - want).abs().max_element() < 1e-5, "{uv}");
         }
+    }
+
+    /// Mean and variance of `n` one-sample estimates drawn by `estimate` from uniform
+    /// numbers.
+    fn moments(n: usize, seed: u64, mut estimate: impl FnMut(Vec2) -> f64) -> (f64, f64) {
+        let mut rng = Pcg32::new(seed, 3);
+        let xs: Vec<f64> = (0..n)
+            .map(|_| estimate(Vec2::new(rng.uniform_f32(), rng.uniform_f32())))
+            .collect();
+        let mean = xs.iter().sum::<f64>() / n as f64;
+        let var = xs.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / (n - 1) as f64;
+        (mean, var)
+    }
+
+    /// What drawing points by the texture is for. An 8 × 8 image, black but for one texel
+    /// of 50 (and 0.05 elsewhere), lights a point above the triangle; the irradiance
+    /// estimate E = L cos θ / p is made 10⁵ times with the texture's cells and 10⁵ times
+    /// uniformly by area (the untextured triangle's sample, times the texture at its
+    /// point). Both estimate the same irradiance: Welch's z stays below 4 (a false alarm
+    /// once in 15 000). Uniform sampling lands near the bright texel in one sample in 8
+    /// (bilinear filtering spreads it over four texels' area of the triangle's 32); the
+    /// cells put most samples there. Measured variance ratio: 28, the same within 15 %
+    /// for cells weighed by their mean or largest lookup and for a defensive share of 2 to
+    /// 10 %: what is left is the variation of cos θ / d² over the triangle, 0.4 below the
+    /// point. The bound asks for 10.
+    #[test]
+    fn drawing_points_by_the_texture_lowers_the_variance() {
+        let mut pixels = vec![Vec3::splat(0.05); 64];
+        pixels[5 * 8 + 2] = Vec3::splat(50.0);
+        let image = Arc::new(ImageDesc {
+            width: 8,
+            height: 8,
+            pixels,
+        });
+        let texture = Arc::new(Texture::Image(ImageTexture {
+            image,
+            wrap: WrapMode::Repeat,
+            uv_transform: Affine2::IDENTITY,
+            scale: Vec3::ONE,
+            channel: None,
+        }));
+        let (p, uv) = (
+            [Vec3::ZERO, Vec3::X, Vec3::Z],
+            [Vec2::ZERO, Vec2::X, Vec2::Y],
+        );
+        let cells = EmissionTexture::new(texture.clone(), uv, Vec3::ONE, texture.mean());
+        let textured = TriangleLight::new(p, Vec3::Y, Vec3::ONE).with_texture(cells);
+        let plain = TriangleLight::new(p, Vec3::Y, Vec3::ONE);
+        let ctx = ShadingCtx {
+            p: Vec3::new(0.6, 0.4, 0.1),
+            n: -Vec3::Y,
+        };
+        let irradiance = |s: LightSample, tex: Vec3| {
+            (s.radiance * tex).x as f64 * s.wi.dot(ctx.n).abs() as f64 / s.pdf as f64
+        };
+        let n = 100_000;
+        let (m_cells, v_cells) = moments(n, 1, |u| {
+            textured
+                .sample_li(&ctx, u)
+                .map_or(0.0, |s| irradiance(s, Vec3::ONE))
+        });
+        let (m_uniform, v_uniform) = moments(n, 2, |u| {
+            plain.sample_li(&ctx, u).map_or(0.0, |s| {
+                irradiance(s, texture.eval(Vec2::new(s.p_light.x, s.p_light.z)))
+            })
+        });
+        let z = (m_cells - m_uniform) / ((v_cells + v_uniform) / n as f64).sqrt();
+        assert!(z.abs() < 4.0, "means {m_cells} and {m_uniform}, z = {z}");
+        assert!(
+            v_uniform > 10.0 * v_cells,
+            "variance {v_cells} with the cells, {v_uniform} uniformly"
+        );
     }
 }
