@@ -142,14 +142,19 @@ fn sphere_light_from_inside_samples_its_area() {
     assert_eq!(r.success_fraction, 0.0);
 }
 
-#[test]
-fn triangle_light_from_a_point() {
+/// The triangle lights' corners, and their normal by the right-hand rule.
+fn slanted_triangle() -> ([Vec3; 3], Vec3) {
     let tri = [
         Vec3::new(-0.5, 1.0, -0.4),
         Vec3::new(0.7, 1.2, -0.2),
         Vec3::new(0.1, 0.9, 0.8),
     ];
-    let n = (tri[1] - tri[0]).cross(tri[2] - tri[0]).normalize();
+    (tri, (tri[1] - tri[0]).cross(tri[2] - tri[0]).normalize())
+}
+
+#[test]
+fn triangle_light_from_a_point() {
+    let (tri, n) = slanted_triangle();
     // Emitting towards -n (downwards) so that the points below see its front.
     let light = Light::Triangle(TriangleLight::new(tri, -n, Vec3::ONE));
     let centroid = (tri[0] + tri[1] + tri[2]) / 3.0;
@@ -174,12 +179,7 @@ fn triangle_light_from_a_point() {
 /// the point its ray hits.
 #[test]
 fn textured_triangle_light_from_a_point() {
-    let tri = [
-        Vec3::new(-0.5, 1.0, -0.4),
-        Vec3::new(0.7, 1.2, -0.2),
-        Vec3::new(0.1, 0.9, 0.8),
-    ];
-    let n = (tri[1] - tri[0]).cross(tri[2] - tri[0]).normalize();
+    let (tri, n) = slanted_triangle();
     let checker = Arc::new(Texture::Checker {
         a: Vec3::new(6.0, 3.0, 1.0),
         b: Vec3::splat(0.2),

@@ -96,8 +96,8 @@ impl EmissionTexture {
             })
             .map(|(sum, max)| (sum / (m * m) as f32, max))
             .collect();
-        let cells = (k * k) as f32;
-        let mean = lookups.iter().map(|(mean, _)| *mean).sum::<Vec3>() / cells;
+        let count = (k * k) as f32;
+        let mean = lookups.iter().map(|(mean, _)| *mean).sum::<Vec3>() / count;
         // Halfway between the mean and the largest lookup: a cell's few bright texels
         // between the lookups are better overrated (a few samples too many there) than
         // missed (samples that weigh up to ten times uniform's).
@@ -105,15 +105,15 @@ impl EmissionTexture {
             .iter()
             .map(|(mean, max)| luminance(tint * (*mean + *max)) * 0.5)
             .collect();
-        let mean_weight = weights.iter().sum::<f32>() / cells;
-        // Drawing points by the cells costs ≈ 30 ns a sample; it is worth it where uniform
+        let mean_weight = weights.iter().sum::<f32>() / count;
+        // Drawing points by the cells costs ≈ 25–30 ns a sample; it is worth it where uniform
         // sampling's relative variance of the emission, the weights' squared coefficient
         // of variation, is at least 1/16.
         let spread = weights
             .iter()
             .map(|w| (w / mean_weight - 1.0).powi(2))
             .sum::<f32>()
-            / cells;
+            / count;
         let cells =
             (mean_weight > 0.0 && mean_weight.is_finite() && spread >= MIN_SPREAD).then(|| {
                 let func: Vec<f32> = weights
