@@ -284,9 +284,9 @@ impl Distribution1D {
     /// Samples a continuous x ∈ [0,1); returns (x, density at x, cell index).
     pub fn sample_continuous(&self, u: f32) -> (f32, f32, usize) {
         let (i, du) = self.sample_cell(u);
-        let pdf = self.func[i] / self.integral;
         let n = self.func.len();
-        (((i as f32 + du) / n as f32).min(ONE_MINUS_EPSILON), pdf, i)
+        let x = ((i as f32 + du) / n as f32).min(ONE_MINUS_EPSILON);
+        (x, self.cell_pdf(i), i)
     }
 
     /// Samples a cell; returns its index and where `u` fell within the cell's share of the
