@@ -31,7 +31,7 @@ sys.path.insert(0, BENCH_DIR)
 
 from benchlib import machine, report  # noqa: E402
 from benchlib.candela import parse_summary  # noqa: E402
-from benchlib.images import RELMSE_EPS  # noqa: E402
+from benchlib.images import RELMSE_EPS, TILE, read_pfm, tile_sums  # noqa: E402
 
 CANDELA = os.path.join(REPO, "target", "release", "candela")
 OUT = os.path.join(BENCH_DIR, "out", "rr_depth")
@@ -39,19 +39,7 @@ SCENES = ["scenes/cornell.toml", "scenes/mitsuba-cornell.xml", "scenes/glass_sph
           "scenes/rough_metals.toml", "scenes/microfacets.toml", "scenes/environment.toml",
           "scenes/ies-room.toml", "scenes/many_lights.toml", "scenes/dof.toml",
           "scenes/instances.toml"]
-TILE = 16
 BOOTSTRAP = 200
-
-
-def read_pfm(path: str) -> np.ndarray:
-    with open(path, "rb") as f:
-        if f.readline().strip() != b"PF":
-            raise ValueError(f"{path}: not an RGB PFM")
-        w, h = (int(v) for v in f.readline().split())
-        scale = float(f.readline())
-        data = np.frombuffer(f.read(), dtype="<f4" if scale < 0 else ">f4")
-    # PFM stores the bottom row first.
-    return data.reshape(h, w, 3)[::-1].astype(np.float64)
 
 
 def render(scene: str, rr: int, seed: int, a) -> tuple:
@@ -64,12 +52,6 @@ def render(scene: str, rr: int, seed: int, a) -> tuple:
         raise RuntimeError(f"{' '.join(cmd)} failed ({p.returncode}):\n{p.stderr}{p.stdout}")
     secs = float(m["secs"])
     return read_pfm(out), secs, float(m["rays"]) * 1e6 * secs
-
-
-def tile_sums(x: np.ndarray) -> np.ndarray:
-    """Per-tile sums of a (h, w) map, tiles of TILE² pixels (partial tiles dropped)."""
-    h, w = (x.shape[0] // TILE) * TILE, (x.shape[1] // TILE) * TILE
-    return x[:h, :w].reshape(h // TILE, TILE, w // TILE, TILE).sum(axis=(1, 3)).ravel()
 
 
 def main() -> None:

@@ -26,6 +26,29 @@ def load_exr(path: str) -> np.ndarray:
     return np.array(bmp, dtype=np.float64)
 
 
+def read_pfm(path: str) -> np.ndarray:
+    """An RGB PFM, as candela writes it, top row first."""
+    with open(path, "rb") as f:
+        if f.readline().strip() != b"PF":
+            raise ValueError(f"{path}: not an RGB PFM")
+        w, h = (int(v) for v in f.readline().split())
+        scale = float(f.readline())
+        data = np.frombuffer(f.read(), dtype="<f4" if scale < 0 else ">f4")
+    # PFM stores the bottom row first.
+    return data.reshape(h, w, 3)[::-1].astype(np.float64)
+
+
+# Side of the pixel tiles that bootstrap standard errors resample (a tile's pixels share
+# their neighbourhood's noise, so tiles, not pixels, are close to independent).
+TILE = 16
+
+
+def tile_sums(x: np.ndarray) -> np.ndarray:
+    """Per-tile sums of a (h, w) map, tiles of TILE² pixels (partial tiles dropped)."""
+    h, w = (x.shape[0] // TILE) * TILE, (x.shape[1] // TILE) * TILE
+    return x[:h, :w].reshape(h // TILE, TILE, w // TILE, TILE).sum(axis=(1, 3)).ravel()
+
+
 def relmse(x: np.ndarray, ref: np.ndarray) -> float:
     """Mean over pixels and channels of (x − ref)² / (ref² + ε)."""
     return float(np.mean((x - ref) ** 2 / (ref ** 2 + RELMSE_EPS)))

@@ -65,8 +65,9 @@ pub fn run(path: &Path, load: &LoadArgs) -> Result<(), UserError> {
         b.max.to_array()
     );
     println!(
-        "render     {}x{}, {} spp, max depth {}, seed {}, mis {:?}, light sampler {:?}",
-        s.width, s.height, s.spp, s.max_depth, s.seed, s.mis, s.light_sampler
+        "render     {}x{}, {} spp, max depth {}, seed {}, mis {:?}, light sampler {:?}, \
+         lamp sampling {:?}",
+        s.width, s.height, s.spp, s.max_depth, s.seed, s.mis, s.light_sampler, s.lamp_sampling
     );
     Ok(())
 }

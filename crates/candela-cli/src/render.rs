@@ -11,7 +11,7 @@ use std::sync::Arc;
 use std::time::Instant;
 
 use candela_core::desc::{
-    ApertureSizeDesc, EnvironmentDesc, EnvironmentMapDesc, FocusDesc, Isa, LensDesc,
+    ApertureSizeDesc, EnvironmentDesc, EnvironmentMapDesc, FocusDesc, Isa, LampSampling, LensDesc,
     LightSamplerKind, MisMode, SamplerKind, SceneDesc, Span,
 };
 use candela_core::integrator;
@@ -111,6 +111,10 @@ pub struct RenderArgs {
     /// How next event estimation picks a light: uniform, power, array, ris, bvh or ris-bvh.
     #[arg(long, value_parser = parse_name::<LightSamplerKind>)]
     light_sampler: Option<LightSamplerKind>,
+    /// How next event estimation draws points on flat lamps: area (uniformly by area, the
+    /// default) or solid-angle (near lamps uniformly in the solid angle they cover).
+    #[arg(long, value_parser = parse_name::<LampSampling>)]
+    lamp_sampling: Option<LampSampling>,
     /// Candidates per pick of the `ris` and `ris-bvh` light samplers.
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..))]
     ris_candidates: Option<u32>,
@@ -178,6 +182,7 @@ impl RenderArgs {
         }
         r.mis = self.mis.unwrap_or(r.mis);
         r.light_sampler = self.light_sampler.unwrap_or(r.light_sampler);
+        r.lamp_sampling = self.lamp_sampling.unwrap_or(r.lamp_sampling);
         if let Some(n) = self.ris_candidates {
             r.ris_candidates = n;
         }

@@ -275,3 +275,51 @@ fn a_bare_obj_or_ply_renders_under_the_default_camera_and_sky() {
         );
     }
 }
+
+/// `--lamp-sampling` reaches the lamps: a panel close over the floor renders differently
+/// (other points drawn on it) under `solid-angle` than by area, the scene's key says the
+/// same as the flag, and a misspelt value is refused before anything renders.
+#[test]
+fn lamp_sampling_flag_and_key_reach_the_lamps() {
+    let panel = "\n[[shape]]\ntype = \"rectangle\"\nmaterial = \"white\"\nemission = 3\n\
+                 transform = [{ rotate = { axis = [1, 0, 0], angle = 90 } }, \
+                 { translate = [0, 0.4, 0] }]\n";
+    let (dir, scene) = scene_dir(&format!("{SCENE}{panel}"));
+    let render = |scene: &PathBuf, name: &str, extra: &[&str]| {
+        let out = dir.path().join(name);
+        let args = [
+            &["render", s(scene), "-o", s(&out), "--threads", "1"],
+            extra,
+        ]
+        .concat();
+        let o = candela(&args);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        std::fs::read(&out).unwrap()
+    };
+    let area = render(&scene, "a.pfm", &[]);
+    assert_eq!(area, render(&scene, "b.pfm", &["--lamp-sampling", "area"]));
+    let solid_angle = render(&scene, "c.pfm", &["--lamp-sampling", "solid-angle"]);
+    assert_ne!(
+        area, solid_angle,
+        "--lamp-sampling solid-angle changed nothing"
+    );
+    let keyed = dir.path().join("keyed.toml");
+    let text = format!("{SCENE}{panel}")
+        .replace("[render]\n", "[render]\nlamp_sampling = \"solid-angle\"\n");
+    std::fs::write(&keyed, text).unwrap();
+    assert_eq!(solid_angle, render(&keyed, "d.pfm", &[]));
+
+    let out = dir.path().join("e.pfm");
+    let o = candela(&[
+        "render",
+        s(&scene),
+        "-o",
+        s(&out),
+        "--lamp-sampling",
+        "sphere",
+    ]);
+    assert_eq!(o.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(err.contains("solid-angle"), "{err}");
+    assert!(!out.exists());
+}

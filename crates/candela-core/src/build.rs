@@ -250,8 +250,11 @@ pub fn build(desc: &SceneDesc) -> Result<Scene, BuildError> {
         .reduce(Aabb::union);
     let scene_radius = bounds.map_or(1.0, |b| (0.5 * (b.max - b.min).length()).max(1e-3));
     for light in &mut lights {
-        if let Light::Directional(d) = light {
-            d.scene_radius = scene_radius;
+        match light {
+            Light::Directional(d) => d.scene_radius = scene_radius,
+            Light::Triangle(t) => t.sampling = r.lamp_sampling,
+            Light::Parallelogram(q) => q.sampling = r.lamp_sampling,
+            _ => {}
         }
     }
     if let Some(env) = &desc.environment {

@@ -93,6 +93,37 @@ pub fn sample_uniform_triangle(u: Vec2) -> Vec3 {
     Vec3::new(b0, b1, 1.0 - b0 - b1)
 }
 
+/// A point of [0, 1) drawn with density ∝ (1 − x)·a + x·b, a, b ≥ 0 not both zero: the
+/// root of its quadratic CDF, in the form that stays exact where a ≈ b.
+#[inline]
+pub fn sample_linear(u: f32, a: f32, b: f32) -> f32 {
+    if u == 0.0 && a == 0.0 {
+        return 0.0;
+    }
+    let x = u * (a + b) / (a + ((1.0 - u) * a * a + u * b * b).sqrt());
+    x.min(ONE_MINUS_EPSILON)
+}
+
+/// A point of the unit square drawn with the bilinear density through the corner weights
+/// `w` at (0, 0), (1, 0), (0, 1) and (1, 1) (non-negative, not all zero): y from its
+/// marginal, then x given y, each linear. Monotone in each coordinate, so stratified
+/// numbers stay stratified.
+#[inline]
+pub fn sample_bilinear(u: Vec2, w: [f32; 4]) -> Vec2 {
+    let y = sample_linear(u.y, w[0] + w[1], w[2] + w[3]);
+    let x = sample_linear(u.x, w[0] + (w[2] - w[0]) * y, w[1] + (w[3] - w[1]) * y);
+    Vec2::new(x, y)
+}
+
+/// Density of [`sample_bilinear`] at `p` with respect to area.
+#[inline]
+pub fn bilinear_pdf(p: Vec2, w: [f32; 4]) -> f32 {
+    let (x, y) = (p.x, p.y);
+    let f =
+        (1.0 - x) * (1.0 - y) * w[0] + x * (1.0 - y) * w[1] + (1.0 - x) * y * w[2] + x * y * w[3];
+    4.0 * f / (w[0] + w[1] + w[2] + w[3])
+}
+
 /// Balance heuristic weight of strategy `f` against strategy `g` (one sample each).
 #[inline]
 pub fn balance_heuristic(pdf_f: f32, pdf_g: f32) -> f32 {

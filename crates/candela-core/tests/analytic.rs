@@ -550,3 +550,71 @@ fn a_checkered_emitter_lights_a_plane_square_by_square() {
         );
     }
 }
+
+/// Lamps close over a diffuse plane, a square of side 2 (one parallelogram light) and a
+/// triangle (half of it), 0.6 above a point off their centres, drawn by area and, under
+/// [`LampSampling::SolidAngle`], in the solid angle they cover (area / d² ≈ 8 and 4, far
+/// above the 0.04 where that starts). Direct light only: the plane's radiance is
+/// ρ/π · L · E, E Lambert's closed form for the polygon (`polygon_irradiance`). Every MIS
+/// mode runs: `NeeOnly` checks the drawn points' density alone, `BsdfOnly` none of it, and
+/// the two heuristics `pdf_li`'s inverse map against it. Tolerance as `check_uniform`'s.
+#[test]
+fn near_lamps_light_a_plane_as_lamberts_formula_says() {
+    let (rho, h, le) = (0.7f32, 0.6f32, 2.0f32);
+    let target = Vec3::new(0.3, 0.0, -0.2);
+    let corner = |x: f32, z: f32| Vec3::new(x, h, z);
+    let square = [
+        corner(-1.0, -1.0),
+        corner(1.0, -1.0),
+        corner(1.0, 1.0),
+        corner(-1.0, 1.0),
+    ];
+    // Wound so that its normal points down, at the plane.
+    let triangle = [square[0], square[1], square[3]];
+    let triangle_mesh = MeshDesc {
+        positions: triangle.to_vec(),
+        indices: vec![[0, 1, 2]],
+        ..Default::default()
+    };
+    let lamps = [
+        (
+            "square",
+            GeometryDesc::Rectangle,
+            Mat4::from_translation(Vec3::Y * h)
+                * Mat4::from_rotation_x(std::f32::consts::FRAC_PI_2),
+            &square[..],
+        ),
+        (
+            "triangle",
+            GeometryDesc::Mesh(std::sync::Arc::new(triangle_mesh)),
+            Mat4::IDENTITY,
+            &triangle[..],
+        ),
+    ];
+    for (what, geometry, transform, polygon) in lamps {
+        let irradiance = candela_core::light::polygon_irradiance(polygon, target, Vec3::Y);
+        let expected = rho as f64 / std::f64::consts::PI * le as f64 * irradiance;
+        for lamp_sampling in [LampSampling::Area, LampSampling::SolidAngle] {
+            for (mis, sampler) in MIS_MODES.into_iter().flat_map(|m| SAMPLERS.map(|s| (m, s))) {
+                let mut desc = SceneDesc {
+                    camera: narrow_camera(target, Vec3::new(0.1, 0.4, 0.05)),
+                    render: RenderSettings {
+                        lamp_sampling,
+                        ..settings(sampler, mis, 1, 64, 13)
+                    },
+                    ..Default::default()
+                };
+                desc.materials.push(material("plane", rho));
+                desc.materials.push(material("black", 0.0));
+                desc.shapes.push(floor_plane("plane"));
+                desc.shapes.push(ShapeDesc {
+                    transform,
+                    ..shape(geometry.clone(), "black", Some(le), false)
+                });
+                let px = render_pixels(&desc);
+                let name = format!("near {what}, {lamp_sampling:?}, {mis:?}, {sampler:?}");
+                check_uniform(&name, &px, expected, true);
+            }
+        }
+    }
+}

@@ -1,28 +1,31 @@
 //! Chi-square tests of every sampling routine of the foundation against the density it
-//! claims: the warps, the sphere, triangle (plain and textured) and parallelogram lights'
-//! `sample_li` against `pdf_li`, the
-//! diffuse BSDF, and the alias table. Each uses 10⁶ samples and a fixed seed; the suite's
-//! family-wise significance is 0.01, split over its tests by the Šidák correction.
+//! claims: the warps (the bilinear one too), the sphere, triangle (plain and textured),
+//! parallelogram and rectangle lights' `sample_li` against `pdf_li` (the triangle and
+//! rectangle under `LampSampling::SolidAngle` too: near, drawn on the sphere, and far, by
+//! area), the diffuse BSDF, and the alias table. Each uses 10⁶ samples and a fixed seed;
+//! the suite's family-wise significance is 0.01, split over its tests by the Šidák
+//! correction.
 
 use std::f32::consts::PI;
 use std::sync::Arc;
 
 use candela_core::bsdf::{Bsdf, Diffuse, Lobe};
 use candela_core::chi2::{discrete, sidak_alpha, Chi2Report, ChiSquareTest};
+use candela_core::desc::LampSampling;
 use candela_core::light::{
     EmissionTexture, Light, ParallelogramLight, ShadingCtx, SphereLight, TriangleLight,
 };
 use candela_core::math::Frame;
 use candela_core::sampler::Pcg32;
 use candela_core::sampling::{
-    cosine_hemisphere_pdf, sample_cosine_hemisphere, sample_uniform_cone, sample_uniform_sphere,
-    uniform_cone_pdf, AliasTable, UNIFORM_SPHERE_PDF,
+    bilinear_pdf, cosine_hemisphere_pdf, sample_bilinear, sample_cosine_hemisphere,
+    sample_uniform_cone, sample_uniform_sphere, uniform_cone_pdf, AliasTable, UNIFORM_SPHERE_PDF,
 };
 use candela_core::texture::Texture;
 use glam::{Affine2, Vec2, Vec3};
 
 /// Number of chi-square tests in this file, for the Šidák correction.
-const TESTS: usize = 27;
+const TESTS: usize = 51;
 
 fn test() -> ChiSquareTest {
     ChiSquareTest {
@@ -75,7 +78,12 @@ fn uniform_cones() {
 /// Tests a light's `sample_li` against its `pdf_li` at `p`, and checks that the pdf a
 /// sample reports equals `pdf_li` of its direction.
 fn light_test(name: &str, light: &Light, p: Vec3) -> Chi2Report {
-    let ctx = ShadingCtx { p, n: Vec3::Y };
+    light_test_seen_by(name, light, ShadingCtx { p, n: Vec3::Y })
+}
+
+/// [`light_test`] at a receiver of normal `ctx.n`: the spherical triangle and rectangle
+/// weigh their directions by the receiver's cosine (none where `n` is zero, in a medium).
+fn light_test_seen_by(name: &str, light: &Light, ctx: ShadingCtx) -> Chi2Report {
     let (mut mismatches, mut samples) = (0usize, 0usize);
     let t = ChiSquareTest {
         // `pdf_li` finds the light again by casting a ray from the shading point. Seen at
@@ -152,25 +160,79 @@ fn slanted_triangle() -> ([Vec3; 3], Vec3) {
     (tri, (tri[1] - tri[0]).cross(tri[2] - tri[0]).normalize())
 }
 
+/// Whether a lamp whose widest extent is `extent2` (squared) is near enough from `p` to
+/// be drawn in the solid angle it covers: wider than its centre is far, the bound of the
+/// light module's `spherical::near`. The placements below fall on both sides of it.
+fn drawn_on_the_sphere(extent2: f32, centre: Vec3, p: Vec3) -> bool {
+    extent2 > centre.distance_squared(p)
+}
+
+/// Points in front of a flat lamp (its centre, the unit normal of its emitting side, one
+/// of its corners), with their names: one facing it as far away as the lamp is wide,
+/// close, oblique, grazing (`graze` in front of its plane, half again as far out as the
+/// corner) and the same three times as far out, and far. The lamps here (1.3 and 1.5
+/// wide) are near, in the sense of [`drawn_on_the_sphere`], from the first four and far
+/// from the last two.
+fn front_placements(
+    centre: Vec3,
+    front: Vec3,
+    corner: Vec3,
+    graze: f32,
+) -> [(&'static str, Vec3); 6] {
+    let out = corner - centre;
+    [
+        ("facing", centre + front),
+        ("close", centre + front * 0.05),
+        ("oblique", centre + front * 0.6 + out * 1.2),
+        ("grazing", centre + front * graze + out * 1.5),
+        ("grazing, far", centre + front * graze + out * 3.0),
+        ("far", centre + front * 3.0 + out),
+    ]
+}
+
+/// Tests a light from a point that sees its front: the chi-square test passes and nearly
+/// every sample reaches the light (a placement behind it would pass with no samples).
+fn assert_lit(report: Chi2Report) {
+    report.assert_passed();
+    assert!(report.success_fraction > 0.99, "{report}");
+}
+
 #[test]
 fn triangle_light_from_a_point() {
     let (tri, n) = slanted_triangle();
-    // Emitting towards -n (downwards) so that the points below see its front.
-    let light = Light::Triangle(TriangleLight::new(tri, -n, Vec3::ONE));
     let centroid = (tri[0] + tri[1] + tri[2]) / 3.0;
-    let grazing = centroid - n * 0.02 + (tri[0] - centroid) * 3.0;
-    for (what, p) in [
-        ("below", Vec3::new(0.0, 0.0, 0.0)),
-        ("close", centroid - n * 0.05),
-        ("oblique", Vec3::new(2.5, 0.2, 1.5)),
-        ("grazing", grazing),
-    ] {
-        light_test(&format!("triangle light, {what}, from {p}"), &light, p).assert_passed();
+    for sampling in [LampSampling::Area, LampSampling::SolidAngle] {
+        // Emitting towards -n, the side the placements are on.
+        let mut plain = TriangleLight::new(tri, -n, Vec3::ONE);
+        plain.sampling = sampling;
+        let extent2 = tri[0].distance_squared(tri[2]);
+        let light = Light::Triangle(plain);
+        for (i, (what, p)) in front_placements(centroid, -n, tri[0], 0.02)
+            .into_iter()
+            .enumerate()
+        {
+            assert_eq!(drawn_on_the_sphere(extent2, centroid, p), i < 4, "{what}");
+            let name = format!("triangle light, {sampling:?}, {what}, from {p}");
+            assert_lit(light_test(&name, &light, p));
+        }
+        // Close, with the cosine warp's weights far apart (a receiver facing along the
+        // lamp) and without them (in a medium); area sampling ignores the receiver.
+        if sampling == LampSampling::SolidAngle {
+            for (what, receiver) in [("sideways", Vec3::X), ("in a medium", Vec3::ZERO)] {
+                let ctx = ShadingCtx {
+                    p: centroid - n * 0.3 + (tri[2] - centroid) * 0.4,
+                    n: receiver,
+                };
+                let name = format!("triangle light, {sampling:?}, close, {what}");
+                assert_lit(light_test_seen_by(&name, &light, ctx));
+            }
+        }
+        // From behind, the triangle shows its back: nothing is sampled, the pdf is zero.
+        let name = format!("triangle light, {sampling:?}, from behind");
+        let r = light_test(&name, &light, centroid + n);
+        r.assert_passed();
+        assert_eq!(r.success_fraction, 0.0);
     }
-    // From behind, the triangle shows its back: nothing is sampled, the pdf is zero.
-    let r = light_test("triangle light from behind", &light, centroid + n);
-    r.assert_passed();
-    assert_eq!(r.success_fraction, 0.0);
 }
 
 /// A triangle with a checker emission draws its points where the checker is bright (its
@@ -189,43 +251,97 @@ fn textured_triangle_light_from_a_point() {
     let texture = EmissionTexture::new(checker.clone(), uv, Vec3::ONE, checker.mean());
     let light = Light::Triangle(TriangleLight::new(tri, -n, Vec3::ONE).with_texture(texture));
     let centroid = (tri[0] + tri[1] + tri[2]) / 3.0;
-    for (what, p) in [
-        ("below", Vec3::new(0.0, 0.0, 0.0)),
-        ("close", centroid - n * 0.05),
-        ("oblique", Vec3::new(2.5, 0.2, 1.5)),
-    ] {
-        light_test(
-            &format!("textured triangle light, {what}, from {p}"),
-            &light,
-            p,
-        )
-        .assert_passed();
+    for (what, p) in front_placements(centroid, -n, tri[0], 0.02)
+        .into_iter()
+        .take(3)
+    {
+        let name = format!("textured triangle light, {what}, from {p}");
+        assert_lit(light_test(&name, &light, p));
     }
 }
 
 #[test]
 fn parallelogram_light_from_a_point() {
-    // A slanted, non-rectangular parallelogram (the merge accepts any), emitting
-    // downwards; the same placements as the triangle's.
+    // A slanted, non-rectangular parallelogram (the merge accepts any), drawn by area
+    // under either `LampSampling`; the triangle's placements.
     let p0 = Vec3::new(-0.5, 1.0, -0.4);
     let (e1, e2) = (Vec3::new(1.2, 0.2, 0.2), Vec3::new(0.3, -0.1, 1.1));
     let n = e1.cross(e2).normalize();
-    let light = Light::Parallelogram(ParallelogramLight::new(p0, e1, e2, -n, Vec3::ONE).unwrap());
+    let mut quad = ParallelogramLight::new(p0, e1, e2, -n, Vec3::ONE).unwrap();
+    quad.sampling = LampSampling::SolidAngle;
+    let light = Light::Parallelogram(quad);
     let centre = p0 + 0.5 * (e1 + e2);
-    // About 1° above the plane (at 0.5°, as for the triangle, the sliver is thinner than
-    // the adaptive quadrature resolves: ∫pdf came out 0.9985 with all else passing).
-    let grazing = centre - n * 0.05 + (p0 - centre) * 3.0;
-    for (what, p) in [
-        ("below", Vec3::new(0.0, 0.0, 0.0)),
-        ("close", centre - n * 0.05),
-        ("oblique", Vec3::new(2.5, 0.2, 1.5)),
-        ("grazing", grazing),
-    ] {
-        light_test(&format!("parallelogram light, {what}, from {p}"), &light, p).assert_passed();
+    // Grazing about 1° above the plane (at 0.5°, as for the triangle, the sliver is
+    // thinner than the adaptive quadrature resolves: ∫pdf came out 0.9985 with all else
+    // passing).
+    for (what, p) in front_placements(centre, -n, p0, 0.05) {
+        assert_lit(light_test(
+            &format!("parallelogram light, {what}, from {p}"),
+            &light,
+            p,
+        ));
     }
     let r = light_test("parallelogram light from behind", &light, centre + n);
     r.assert_passed();
     assert_eq!(r.success_fraction, 0.0);
+}
+
+/// A rectangle light under [`LampSampling::SolidAngle`], which is drawn on the sphere
+/// where it is near (Ureña et al.'s spherical rectangle, cosine-warped), from the
+/// triangle's placements.
+#[test]
+fn rectangle_light_from_a_point() {
+    let p0 = Vec3::new(-0.5, 1.0, -0.4);
+    let e1 = Vec3::new(1.2, 0.3, 0.2);
+    let e2 = e1.cross(Vec3::new(0.1, 1.0, -0.3)).normalize() * 0.9;
+    let n = e1.cross(e2).normalize();
+    let mut rect = ParallelogramLight::new(p0, e1, e2, -n, Vec3::ONE).unwrap();
+    rect.sampling = LampSampling::SolidAngle;
+    let light = Light::Parallelogram(rect);
+    let centre = p0 + 0.5 * (e1 + e2);
+    let extent2 = (e1 + e2).length_squared();
+    for (i, (what, p)) in front_placements(centre, -n, p0, 0.05)
+        .into_iter()
+        .enumerate()
+    {
+        assert_eq!(drawn_on_the_sphere(extent2, centre, p), i < 4, "{what}");
+        assert_lit(light_test(
+            &format!("rectangle light, {what}, from {p}"),
+            &light,
+            p,
+        ));
+    }
+    for (what, receiver) in [("sideways", e1.normalize()), ("in a medium", Vec3::ZERO)] {
+        let ctx = ShadingCtx {
+            p: centre - n * 0.1 + e2 * 0.3,
+            n: receiver,
+        };
+        assert_lit(light_test_seen_by(
+            &format!("rectangle light, close, {what}"),
+            &light,
+            ctx,
+        ));
+    }
+    let r = light_test("rectangle light from behind", &light, centre + n * 0.1);
+    r.assert_passed();
+    assert_eq!(r.success_fraction, 0.0);
+}
+
+/// The bilinear warp that weighs a spherical polygon's directions by the receiver's
+/// cosine, against its density: weights near alike, and far apart with a zero.
+#[test]
+fn bilinear_warp() {
+    for w in [[1.0f32, 1.2, 0.9, 1.1], [0.01, 3.0, 0.5, 0.0]] {
+        test()
+            .planar(
+                &format!("bilinear warp, corner weights {w:?}"),
+                Vec2::ZERO,
+                Vec2::ONE,
+                |u| Some(sample_bilinear(u, w)),
+                |p| bilinear_pdf(p, w),
+            )
+            .assert_passed();
+    }
 }
 
 #[test]

@@ -11,8 +11,8 @@
 use std::path::Path;
 
 use candela_core::desc::{
-    BsdfDesc, EmissionProfileDesc, LightSamplerKind, MaterialDesc, MisMode, RenderSettings,
-    SamplerKind, SceneDesc,
+    BsdfDesc, EmissionProfileDesc, LampSampling, LightSamplerKind, MaterialDesc, MisMode,
+    RenderSettings, SamplerKind, SceneDesc,
 };
 use serde::de::DeserializeOwned;
 use serde::Deserialize;
@@ -180,6 +180,7 @@ struct RenderSection {
     seed: Option<u64>,
     mis: Option<MisMode>,
     light_sampler: Option<LightSamplerKind>,
+    lamp_sampling: Option<LampSampling>,
     ris_candidates: Option<std::num::NonZeroU32>,
     sampler: Option<SamplerKind>,
 }
@@ -198,6 +199,7 @@ fn parse_render(src: &Source, value: Item) -> Result<RenderSettings, LoadError> 
     out.seed = r.seed.unwrap_or(out.seed);
     out.mis = r.mis.unwrap_or(out.mis);
     out.light_sampler = r.light_sampler.unwrap_or(out.light_sampler);
+    out.lamp_sampling = r.lamp_sampling.unwrap_or(out.lamp_sampling);
     if let Some(n) = r.ris_candidates {
         out.ris_candidates = n.get();
     }

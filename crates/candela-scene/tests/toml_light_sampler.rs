@@ -1,8 +1,8 @@
-//! The `light_sampler` and `ris_candidates` render keys.
+//! The `light_sampler`, `ris_candidates` and `lamp_sampling` render keys.
 
 use std::path::Path;
 
-use candela_core::desc::{LightSamplerKind, DEFAULT_RIS_CANDIDATES};
+use candela_core::desc::{LampSampling, LightSamplerKind, DEFAULT_RIS_CANDIDATES};
 use candela_scene::parse_toml_scene;
 
 fn parse(text: &str) -> Result<candela_core::desc::SceneDesc, String> {
@@ -38,4 +38,23 @@ fn bad_light_sampler_values_point_at_the_value() {
     assert!(zero.starts_with("scene.toml:2:18: "), "{zero}");
     let negative = parse("[render]\nris_candidates = -3\n").unwrap_err();
     assert!(negative.starts_with("scene.toml:2:18: "), "{negative}");
+}
+
+#[test]
+fn lamp_sampling_loads_and_defaults_to_area() {
+    assert_eq!(
+        parse("[render]\n").unwrap().render.lamp_sampling,
+        LampSampling::Area
+    );
+    for (name, kind) in [
+        ("area", LampSampling::Area),
+        ("solid-angle", LampSampling::SolidAngle),
+    ] {
+        let desc = parse(&format!("[render]\nlamp_sampling = \"{name}\"\n")).unwrap();
+        assert_eq!(desc.render.lamp_sampling, kind, "{name}");
+    }
+    assert_eq!(
+        parse("[render]\nspp = 4\nlamp_sampling = \"solid_angle\"\n").unwrap_err(),
+        "scene.toml:3:17: unknown variant `solid_angle`, expected `area` or `solid-angle`"
+    );
 }

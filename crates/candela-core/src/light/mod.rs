@@ -24,6 +24,7 @@ mod positional;
 mod profile;
 mod projector;
 mod sphere;
+mod spherical;
 mod spot;
 mod triangle;
 
@@ -37,6 +38,7 @@ pub use point::PointLight;
 pub use profile::LightProfile;
 pub use projector::ProjectorLight;
 pub use sphere::SphereLight;
+pub use spherical::polygon_irradiance;
 pub use spot::SpotLight;
 pub use triangle::TriangleLight;
 

@@ -1,7 +1,9 @@
 use glam::{Vec2, Vec3};
 
+use super::spherical::{self, SphericalRectangle};
 use super::triangle::solid_angle;
 use super::{flat_importance, LightBounds, LightSample, ShadingCtx, TriangleLight};
+use crate::desc::LampSampling;
 use crate::geometry::Aabb;
 use crate::math::luminance;
 
@@ -17,7 +19,11 @@ use crate::math::luminance;
 /// warp is also cheaper (no fold) and the light sampler has one light fewer to pick.
 ///
 /// Sampled uniformly by area; the density in solid angle at the shading point is
-/// p_ω = d² / (|cos θ_l| · A), as for [`TriangleLight`].
+/// p_ω = d² / (|cos θ_l| · A), as for [`TriangleLight`]. With
+/// [`LampSampling::SolidAngle`], a rectangle that is near (see [`spherical::near`]) has
+/// its direction drawn in the spherical rectangle it covers instead, weighted by the
+/// receiver's cosine ([`SphericalRectangle`]); a parallelogram with skewed corners stays
+/// sampled by area.
 #[derive(Clone, Debug)]
 pub struct ParallelogramLight {
     pub p0: Vec3,
@@ -30,6 +36,19 @@ pub struct ParallelogramLight {
     /// Dual vectors of (e₁, e₂) in the plane: (q − p₀)·`d1` = a, (q − p₀)·`d2` = b.
     d1: Vec3,
     d2: Vec3,
+    /// Where the edges are orthogonal: their unit vectors and lengths.
+    rectangle: Option<Rectangle>,
+    /// Whether a near point is drawn in the solid angle the rectangle covers.
+    pub sampling: LampSampling,
+}
+
+/// The frame of a rectangular [`ParallelogramLight`].
+#[derive(Clone, Copy, Debug)]
+struct Rectangle {
+    x: Vec3,
+    y: Vec3,
+    lx: f32,
+    ly: f32,
 }
 
 impl ParallelogramLight {
@@ -43,6 +62,14 @@ impl ParallelogramLight {
         }
         // Solve q = a·e1 + b·e2 in the plane: a = q·(e2 × c)/|c|², b = q·(c × e1)/|c|².
         let inv = 1.0 / (area * area);
+        let (lx, ly) = (e1.length(), e2.length());
+        // Orthogonal to 10⁻⁵ rad: the spherical rectangle is then exact to f32 precision.
+        let rectangle = (e1.dot(e2).abs() <= 1e-5 * lx * ly).then(|| Rectangle {
+            x: e1 / lx,
+            y: e2 / ly,
+            lx,
+            ly,
+        });
         Some(ParallelogramLight {
             p0,
             e1,
@@ -52,6 +79,8 @@ impl ParallelogramLight {
             le,
             d1: e2.cross(c) * inv,
             d2: c.cross(e1) * inv,
+            rectangle,
+            sampling: LampSampling::Area,
         })
     }
 
@@ -85,11 +114,35 @@ impl ParallelogramLight {
         if ((x + y) - (s0 + s1)).abs().max_element() > 1e-6 * size {
             return None;
         }
-        ParallelogramLight::new(x, s0 - x, s1 - x, a.n, a.le)
+        let quad = ParallelogramLight::new(x, s0 - x, s1 - x, a.n, a.le)?;
+        Some(ParallelogramLight {
+            sampling: a.sampling,
+            ..quad
+        })
+    }
+
+    /// The rectangle as the spherical rectangle it covers seen from `p`, where it is near
+    /// enough to be drawn there (see [`spherical::near`]).
+    #[inline]
+    fn spherical(&self, p: Vec3) -> Option<SphericalRectangle> {
+        if self.sampling == LampSampling::Area {
+            return None;
+        }
+        let r = self.rectangle?;
+        let centre = self.p0 + 0.5 * (self.e1 + self.e2);
+        if !spherical::near(r.lx * r.lx + r.ly * r.ly, centre.distance_squared(p)) {
+            return None;
+        }
+        SphericalRectangle::new(p, self.p0, r.x, r.y, r.lx, r.ly)
     }
 
     #[inline]
     pub fn sample_li(&self, ctx: &ShadingCtx, u: Vec2) -> Option<LightSample> {
+        if let Some(sphere) = self.spherical(ctx.p) {
+            let (q, pdf) = sphere.sample(ctx, u);
+            return LightSample::uniform_area(ctx.p, q, self.n, self.area, |_| self.le)
+                .map(|s| LightSample { pdf, ..s });
+        }
         let p = self.p0 + self.e1 * u.x + self.e2 * u.y;
         LightSample::uniform_area(ctx.p, p, self.n, self.area, |_| self.le)
     }
@@ -109,6 +162,9 @@ impl ParallelogramLight {
         let (a, b) = (q.dot(self.d1), q.dot(self.d2));
         if !((0.0..=1.0).contains(&a) && (0.0..=1.0).contains(&b)) {
             return 0.0;
+        }
+        if let Some(sphere) = self.spherical(ctx.p) {
+            return sphere.pdf(ctx, self.p0 + q);
         }
         t * t / (cos_l * self.area)
     }
@@ -240,15 +296,29 @@ mod tests {
         assert!(ParallelogramLight::from_triangles(&a, &tri([x, x + y, y], le)).is_some());
     }
 
+    /// By area the density towards the lamp's centre is d²/(A cos θ): 1/2 from 1 away,
+    /// 50 from 10 away. Under [`LampSampling::SolidAngle`] the lamp is drawn on the sphere
+    /// from 1 away (its density there is the chi-square suite's) and still by area from 10.
+    /// Neither finds it off its outline or from behind.
     #[test]
     fn pdf_li_is_zero_off_the_parallelogram_and_behind_it() {
-        let p = ParallelogramLight::new(Vec3::ZERO, Vec3::X, Vec3::Y * 2.0, -Vec3::Z, Vec3::ONE)
-            .unwrap();
+        let mut p =
+            ParallelogramLight::new(Vec3::ZERO, Vec3::X, Vec3::Y * 2.0, -Vec3::Z, Vec3::ONE)
+                .unwrap();
+        let far = ShadingCtx {
+            p: Vec3::new(0.5, 1.0, -10.0),
+            n: Vec3::Z,
+        };
         let ctx = ShadingCtx {
             p: Vec3::new(0.5, 1.0, -1.0),
             n: Vec3::Z,
         };
-        assert!((p.pdf_li(&ctx, Vec3::Z) - 1.0 / 2.0).abs() < 1e-6);
+        assert!((p.pdf_li(&far, Vec3::Z) - 50.0).abs() < 1e-4);
+        assert!((p.pdf_li(&ctx, Vec3::Z) - 0.5).abs() < 1e-6);
+        p.sampling = LampSampling::SolidAngle;
+        assert!((p.pdf_li(&far, Vec3::Z) - 50.0).abs() < 1e-4);
+        let near = p.pdf_li(&ctx, Vec3::Z);
+        assert!(near > 0.0 && (near - 0.5).abs() > 1e-3, "{near}");
         let off = (Vec3::new(1.2, 1.0, 0.0) - ctx.p).normalize();
         assert_eq!(p.pdf_li(&ctx, off), 0.0);
         assert_eq!(p.pdf_li(&ctx, -Vec3::Z), 0.0);

@@ -2,7 +2,12 @@ use std::f32::consts::PI;
 
 use glam::{Vec2, Vec3};
 
-use super::{flat_importance, EmissionTexture, LightBounds, LightProfile, LightSample, ShadingCtx};
+use super::spherical::{self, SphericalTriangle};
+use super::{
+    flat_importance, positive_finite, EmissionTexture, LightBounds, LightProfile, LightSample,
+    ShadingCtx,
+};
+use crate::desc::LampSampling;
 use crate::geometry::Aabb;
 use crate::geometry::{Ray, WatertightRay};
 use crate::math::luminance;
@@ -10,13 +15,15 @@ use crate::sampling::sample_uniform_triangle;
 
 /// One emitting triangle of a mesh. Emits `le` on the side its normal `n` points to.
 /// Sampled uniformly by area; the density is converted to solid angle at the shading
-/// point, p_ω = d² / (|cos θ_l| · A).
+/// point, p_ω = d² / (|cos θ_l| · A). With [`LampSampling::SolidAngle`], where it is near
+/// (see [`spherical::near`]), the direction is drawn in the spherical triangle it covers
+/// instead, weighted by the receiver's cosine ([`SphericalTriangle`]).
 ///
 /// With a `profile` (an IES-shaped area light) the radiance leaving towards ω is
 /// `le` · I(ω)/I_max, the profile's nadir along `n`: each point of the surface emits with
 /// the profile's shape times the Lambertian cos θ, so the triangle's intensity is
-/// A · `le` · cos θ · I(ω)/I_max. Sampling stays uniform by area (its density does not
-/// depend on the emitted radiance; only the value does).
+/// A · `le` · cos θ · I(ω)/I_max. The profile does not change how points are drawn (their
+/// density does not depend on the emitted radiance; only the value does).
 ///
 /// With a `texture` the radiance is `le` × the texture at the point's uv. Light selection
 /// weighs the triangle by its mean radiance, so a triangle over a dark part of an image
@@ -33,6 +40,10 @@ pub struct TriangleLight {
     /// ∫ (radiance / `le`) cos θ dω over the hemisphere: π without a profile.
     pub projected_solid_angle: f32,
     pub texture: Option<EmissionTexture>,
+    /// Whether a near point is drawn in the solid angle the triangle covers.
+    pub sampling: LampSampling,
+    /// The longest edge's squared length, which says where it is near.
+    extent2: f32,
 }
 
 impl TriangleLight {
@@ -47,6 +58,11 @@ impl TriangleLight {
             profile: None,
             projected_solid_angle: PI,
             texture: None,
+            sampling: LampSampling::Area,
+            extent2: [(0, 1), (1, 2), (2, 0)]
+                .map(|(i, j)| p[i].distance_squared(p[j]))
+                .into_iter()
+                .fold(0.0, f32::max),
         }
     }
 
@@ -86,7 +102,44 @@ impl TriangleLight {
         }
     }
 
+    /// The triangle as the spherical triangle it covers seen from `p`, where it is near
+    /// enough to be drawn there (see [`spherical::near`]) and is not textured (a texture
+    /// draws its points by its own density over the triangle).
+    #[inline]
+    fn spherical(&self, p: Vec3) -> Option<SphericalTriangle> {
+        if self.sampling == LampSampling::Area || self.texture.is_some() {
+            return None;
+        }
+        let centroid = (self.p[0] + self.p[1] + self.p[2]) * (1.0 / 3.0);
+        if !spherical::near(self.extent2, centroid.distance_squared(p)) {
+            return None;
+        }
+        SphericalTriangle::new(&self.p, p)
+    }
+
     pub fn sample_li(&self, ctx: &ShadingCtx, u: Vec2) -> Option<LightSample> {
+        if let Some(sphere) = self.spherical(ctx.p) {
+            let h = (ctx.p - self.p[0]).dot(self.n);
+            if h <= 0.0 {
+                return None;
+            }
+            let s = sphere.sample(ctx, u);
+            // The point where the drawn direction meets the triangle's plane.
+            let cos_l = -s.wi.dot(self.n);
+            let distance = h / cos_l;
+            if !positive_finite(distance) {
+                return None;
+            }
+            return Some(LightSample {
+                radiance: self.emitted(Vec3::ONE, -s.wi),
+                wi: s.wi,
+                distance,
+                pdf: s.pdf,
+                is_delta: false,
+                p_light: ctx.p + s.wi * distance,
+                n_light: self.n,
+            });
+        }
         let Some(texture) = &self.texture else {
             let b = sample_uniform_triangle(u);
             let p = self.p[0] * b.x + self.p[1] * b.y + self.p[2] * b.z;
@@ -110,6 +163,9 @@ impl TriangleLight {
         let ray = Ray::new(ctx.p, wi);
         match WatertightRay::new(&ray).intersect(self.p[0], self.p[1], self.p[2], f32::INFINITY) {
             Some(hit) => {
+                if let Some(sphere) = self.spherical(ctx.p) {
+                    return sphere.pdf(ctx, wi);
+                }
                 let density = self
                     .texture
                     .as_ref()
@@ -298,5 +354,74 @@ mod tests {
             v_uniform > 10.0 * v_cells,
             "variance {v_cells} with the cells, {v_uniform} uniformly"
         );
+    }
+
+    /// What drawing near lamps in solid angle is for. A triangle and a square lamp of
+    /// side 2, 0.3 above a point (off centre, so the cosine warp's corners differ), light
+    /// it: the irradiance estimate E = L cos θ / p is made 10⁵ times each way. By area the
+    /// estimate carries cos θ_r cos θ_l / d² over the lamp, which here varies from its
+    /// value at the foot of the point by a factor of about 100; in solid angle only
+    /// cos θ_r is left, and the warp takes out most of it. Both means match Lambert's
+    /// closed form (z below 4, a false alarm once in 15 000 each), and the test asks area
+    /// sampling's variance to be over 10 times solid angle's (measured: 43 for the
+    /// triangle, 41 for the square).
+    #[test]
+    fn drawing_near_lamps_in_solid_angle_lowers_the_variance() {
+        use super::super::{polygon_irradiance, Light, ParallelogramLight};
+        let ctx = ShadingCtx {
+            p: Vec3::new(0.3, 0.0, -0.2),
+            n: Vec3::Y,
+        };
+        let corners = [
+            Vec3::new(-1.0, 0.3, -1.0),
+            Vec3::new(1.0, 0.3, -1.0),
+            Vec3::new(-1.0, 0.3, 1.0),
+        ];
+        let (e1, e2) = (Vec3::X * 2.0, Vec3::Z * 2.0);
+        let irradiance = |s: LightSample| s.radiance.x as f64 * s.wi.y as f64 / s.pdf as f64;
+        for (what, light, polygon) in [
+            (
+                "triangle",
+                Light::Triangle(TriangleLight::new(corners, -Vec3::Y, Vec3::ONE)),
+                corners.to_vec(),
+            ),
+            (
+                "square",
+                Light::Parallelogram(
+                    ParallelogramLight::new(corners[0], e1, e2, -Vec3::Y, Vec3::ONE).unwrap(),
+                ),
+                vec![
+                    corners[0],
+                    corners[0] + e1,
+                    corners[0] + e1 + e2,
+                    corners[2],
+                ],
+            ),
+        ] {
+            let mut near = light.clone();
+            match &mut near {
+                Light::Triangle(t) => t.sampling = LampSampling::SolidAngle,
+                Light::Parallelogram(q) => q.sampling = LampSampling::SolidAngle,
+                _ => unreachable!(),
+            }
+            let n = 100_000;
+            let (m_area, v_area) =
+                moments(n, 3, |u| light.sample_li(&ctx, u).map_or(0.0, irradiance));
+            let (m_near, v_near) =
+                moments(n, 4, |u| near.sample_li(&ctx, u).map_or(0.0, irradiance));
+            let exact = polygon_irradiance(&polygon, ctx.p, ctx.n);
+            for (how, m, v) in [
+                ("by area", m_area, v_area),
+                ("in solid angle", m_near, v_near),
+            ] {
+                let z = (m - exact) / (v / n as f64).sqrt();
+                assert!(z.abs() < 4.0, "{what} {how}: {m} against {exact}, z = {z}");
+            }
+            assert!(
+                v_area > 10.0 * v_near,
+                "{what}: variance {v_area} by area, {v_near} in solid angle ({})",
+                v_area / v_near
+            );
+        }
     }
 }
