@@ -359,12 +359,12 @@ mod tests {
     /// What drawing near lamps in solid angle is for. A triangle and a square lamp of
     /// side 2, 0.3 above a point (off centre, so the cosine warp's corners differ), light
     /// it: the irradiance estimate E = L cos θ / p is made 10⁵ times each way. By area the
-    /// estimate carries cos θ_r cos θ_l / d² over the lamp, which here varies from its
-    /// value at the foot of the point by a factor of about 100; in solid angle only
-    /// cos θ_r is left, and the warp takes out most of it. Both means match Lambert's
-    /// closed form (z below 4, a false alarm once in 15 000 each), and the test asks area
-    /// sampling's variance to be over 10 times solid angle's (measured: 43 for the
-    /// triangle, 41 for the square).
+    /// estimate carries cos θ_r cos θ_l / d² over the lamp, which here falls from its
+    /// value at the foot of the point to the farthest corner by a factor of 1 300; in
+    /// solid angle only cos θ_r is left, and the warp takes out most of it. Both means
+    /// match Lambert's closed form (z below 4, a false alarm once in 15 000 each), and the
+    /// test asks area sampling's variance to be over 10 times solid angle's (measured: 43
+    /// for the triangle, 41 for the square).
     #[test]
     fn drawing_near_lamps_in_solid_angle_lowers_the_variance() {
         use super::super::{polygon_irradiance, Light, ParallelogramLight};
