@@ -545,4 +545,97 @@ mod tests {
             );
         }
     }
+
+    /// Random rectangles and triangles under [`LampSampling::SolidAngle`] at every scale
+    /// from 10⁻³ to 10³, and points in front of them from a millionth of their size off
+    /// their plane to ten times their size away, with random receiver normals (a third
+    /// in a medium): sampling never panics and returns finite samples and densities, and
+    /// `pdf_li` of the direction drawn agrees with the sample's density to 1 % in all but
+    /// a thousandth of the samples at least 10⁻⁴ of the lamp's size off its plane. (Closer
+    /// than that the f32 direction no longer finds the point it was drawn towards, by area
+    /// or in solid angle alike.) Measured: 200 000 samples, 111 355 from near points;
+    /// 10 of 142 996 disagree, each a ray that just misses the lamp's edge (9 drawn by
+    /// area, 1 in solid angle).
+    #[test]
+    fn random_lamps_and_points_give_finite_consistent_samples() {
+        use super::super::{Light, ParallelogramLight, TriangleLight};
+        use crate::desc::LampSampling;
+        let mut rng = Pcg32::new(31, 7);
+        let mut r = move || rng.uniform_f32();
+        let (mut samples, mut checked, mut disagree, mut spherical) = (0, 0, 0, 0);
+        for i in 0..200_000 {
+            let scale = 10f32.powf(6.0 * r() - 3.0);
+            let dir = |r: &mut dyn FnMut() -> f32| {
+                Vec3::new(r() - 0.5, r() - 0.5, r() - 0.5).normalize_or(Vec3::X)
+            };
+            let x = dir(&mut r);
+            let y = x
+                .cross(dir(&mut r))
+                .normalize_or(x.any_orthonormal_vector());
+            let corner = (Vec3::new(r(), r(), r()) - 0.5) * 4.0 * scale;
+            let (ex, ey) = (x * scale * (0.1 + r()), y * scale * (0.1 + r()));
+            let n = x.cross(y);
+            let (centre, extent2) = if i % 2 == 0 {
+                (corner + 0.5 * (ex + ey), (ex + ey).length_squared())
+            } else {
+                let edges = [ex, ey, ex - ey].map(Vec3::length_squared);
+                (
+                    corner + (ex + ey) / 3.0,
+                    edges.into_iter().fold(0.0, f32::max),
+                )
+            };
+            let mut light = if i % 2 == 0 {
+                Light::Parallelogram(
+                    ParallelogramLight::new(corner, ex, ey, -n, Vec3::ONE).unwrap(),
+                )
+            } else {
+                Light::Triangle(TriangleLight::new(
+                    [corner, corner + ex, corner + ey],
+                    -n,
+                    Vec3::ONE,
+                ))
+            };
+            match &mut light {
+                Light::Parallelogram(q) => q.sampling = LampSampling::SolidAngle,
+                Light::Triangle(t) => t.sampling = LampSampling::SolidAngle,
+                _ => unreachable!(),
+            }
+            // In front of the lamp, anywhere across it.
+            let height = 10f32.powf(7.0 * r() - 6.0);
+            let off = -n * scale * height;
+            let across = (ex * (3.0 * r() - 1.0) + ey * (3.0 * r() - 1.0)) * (r() * 2.0);
+            let ctx = ShadingCtx {
+                p: corner + across + off,
+                n: if i % 3 == 0 { Vec3::ZERO } else { dir(&mut r) },
+            };
+            let drawn_on_the_sphere = near(extent2, centre.distance_squared(ctx.p));
+            let Some(s) = light.sample_li(&ctx, Vec2::new(r(), r())) else {
+                continue;
+            };
+            samples += 1;
+            assert!(s.pdf.is_finite() && s.pdf > 0.0, "{i}: pdf {}", s.pdf);
+            assert!(
+                s.distance.is_finite() && s.distance > 0.0,
+                "{i}: distance {}",
+                s.distance
+            );
+            assert!((s.wi.length() - 1.0).abs() < 1e-4, "{i}: wi {}", s.wi);
+            let pdf = light.pdf_li(&ctx, s.wi);
+            assert!(pdf.is_finite() && pdf >= 0.0, "{i}: pdf_li {pdf}");
+            if height > 1e-4 {
+                checked += 1;
+                disagree += ((pdf / s.pdf - 1.0).abs() > 1e-2) as usize;
+            }
+            spherical += drawn_on_the_sphere as usize;
+        }
+        eprintln!("{samples} samples, {spherical} near, {disagree} of {checked} disagree");
+        assert!(
+            spherical > samples / 4,
+            "{spherical} of {samples} in solid angle"
+        );
+        assert!(
+            disagree * 1000 <= checked,
+            "{disagree} of {checked} disagree"
+        );
+    }
 }
