@@ -30,9 +30,8 @@ BENCH_DIR = os.path.dirname(os.path.abspath(__file__))
 REPO = os.path.dirname(BENCH_DIR)
 sys.path.insert(0, BENCH_DIR)
 
-from benchlib import machine, report  # noqa: E402
-from benchlib.candela import parse_summary  # noqa: E402
-from benchlib.images import RELMSE_EPS, read_pfm, tile_sums  # noqa: E402
+from benchlib import candela, machine, report  # noqa: E402
+from benchlib.images import read_pfm, relative_variances, tile_ratio, tile_sums  # noqa: E402
 
 CANDELA = os.path.join(REPO, "target", "release", "candela")
 OUT = os.path.join(BENCH_DIR, "out", "lamp_sampling")
@@ -54,11 +53,8 @@ def render(scene: str, mode: str, seed: int, res: str, a) -> tuple:
            "--threads", str(a.threads), "--res", res, "--lamp-sampling", mode]
     if a.max_depth is not None:
         cmd += ["--max-depth", str(a.max_depth)]
-    p = subprocess.run(cmd, cwd=REPO, capture_output=True, text=True)
-    m = parse_summary(p.stdout)
-    if p.returncode != 0 or m is None:
-        raise RuntimeError(f"{' '.join(cmd)} failed ({p.returncode}):\n{p.stderr}{p.stdout}")
-    return read_pfm(out), float(m["secs"])
+    secs = float(candela.run(cmd, cwd=REPO)["secs"])
+    return read_pfm(out), secs
 
 
 def main() -> None:
@@ -88,24 +84,19 @@ def main() -> None:
         for seed in range(1, a.seeds + 1):
             for mode in MODES:
                 runs[mode].append(render(scene, mode, seed, res, a))
-        mean = np.mean([img for mode in MODES for img, _ in runs[mode]], axis=0)
-        den = mean ** 2 + RELMSE_EPS
-        per_mode = {}
-        for mode in MODES:
-            imgs = np.array([img for img, _ in runs[mode]])
-            rel = (imgs.var(axis=0, ddof=1) / den).mean(axis=-1)
-            per_mode[mode] = dict(tiles=tile_sums(rel), rel=float(rel.mean()),
-                                  secs=statistics.median(s for _, s in runs[mode]))
+        rel = relative_variances({mode: [img for img, _ in runs[mode]] for mode in MODES})
+        per_mode = {mode: dict(tiles=tile_sums(rel[mode]), rel=float(rel[mode].mean()),
+                               secs=statistics.median(s for _, s in runs[mode]))
+                    for mode in MODES}
         area, solid = per_mode["area"], per_mode["solid-angle"]
-        ratio = area["tiles"].sum() / solid["tiles"].sum()
-        n_tiles = len(area["tiles"])
-        picks = rng.integers(0, n_tiles, size=(BOOTSTRAP, n_tiles))
-        boot = area["tiles"][picks].sum(axis=1) / solid["tiles"][picks].sum(axis=1)
-        time_ratio = solid["secs"] / area["secs"]
+        ratio, se = tile_ratio(area["tiles"], solid["tiles"], rng, BOOTSTRAP)
+        # candela prints seconds to 0.01 s: a render shorter than that has no ratio.
+        timed = min(area["secs"], solid["secs"]) > 0
+        time_ratio = solid["secs"] / area["secs"] if timed else float("nan")
         rows.append([scene, res, f"{area['rel']:.4e}", f"{area['secs']:.2f}",
                      f"{solid['rel']:.4e}", f"{solid['secs']:.2f}",
-                     f"{ratio:.3f} ± {boot.std(ddof=1):.3f}", f"{time_ratio:.3f}",
-                     f"**{ratio / time_ratio:.2f}**"])
+                     f"{ratio:.3f} ± {se:.3f}", f"{time_ratio:.3f}",
+                     f"**{ratio / time_ratio:.2f}**" if timed else "n/a"])
         print(f"[lamp_sampling] {rows[-1]}", flush=True)
     header = ["scene", "res", "area: rel. var.", "s", "solid angle: rel. var.", "s",
               "variance ratio", "time ratio", "efficiency"]

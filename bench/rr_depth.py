@@ -29,9 +29,8 @@ BENCH_DIR = os.path.dirname(os.path.abspath(__file__))
 REPO = os.path.dirname(BENCH_DIR)
 sys.path.insert(0, BENCH_DIR)
 
-from benchlib import machine, report  # noqa: E402
-from benchlib.candela import parse_summary  # noqa: E402
-from benchlib.images import RELMSE_EPS, TILE, read_pfm, tile_sums  # noqa: E402
+from benchlib import candela, machine, report  # noqa: E402
+from benchlib.images import TILE, read_pfm, relative_variances, tile_ratio, tile_sums  # noqa: E402
 
 CANDELA = os.path.join(REPO, "target", "release", "candela")
 OUT = os.path.join(BENCH_DIR, "out", "rr_depth")
@@ -46,10 +45,7 @@ def render(scene: str, rr: int, seed: int, a) -> tuple:
     out = os.path.join(OUT, f"{os.path.basename(scene)}_rr{rr}_{seed}.pfm")
     cmd = [CANDELA, "render", scene, "-o", out, "--spp", str(a.spp), "--seed", str(seed),
            "--threads", str(a.threads), "--res", a.res, "--rr-depth", str(rr)]
-    p = subprocess.run(cmd, cwd=REPO, capture_output=True, text=True)
-    m = parse_summary(p.stdout)
-    if p.returncode != 0 or m is None:
-        raise RuntimeError(f"{' '.join(cmd)} failed ({p.returncode}):\n{p.stderr}{p.stdout}")
+    m = candela.run(cmd, cwd=REPO)
     secs = float(m["secs"])
     return read_pfm(out), secs, float(m["rays"]) * 1e6 * secs
 
@@ -76,24 +72,18 @@ def main() -> None:
     rows = []
     for scene in a.scenes:
         runs = {rr: [render(scene, rr, s + 1, a) for s in range(a.seeds)] for rr in rrs}
-        mean = np.mean([img for rr in rrs for img, _, _ in runs[rr]], axis=0)
-        den = mean ** 2 + RELMSE_EPS
+        rel = relative_variances({rr: [img for img, _, _ in runs[rr]] for rr in rrs})
         per_rr = {}
         for rr in rrs:
-            imgs = np.array([img for img, _, _ in runs[rr]])
-            rel = (imgs.var(axis=0, ddof=1) / den).mean(axis=-1)
-            per_rr[rr] = dict(tiles=tile_sums(rel),
+            per_rr[rr] = dict(tiles=tile_sums(rel[rr]),
                               secs=np.mean([s for _, s, _ in runs[rr]]),
                               rays=np.mean([r for _, _, r in runs[rr]]))
         n_tiles = len(per_rr[rrs[0]]["tiles"])
-        picks = rng.integers(0, n_tiles, size=(BOOTSTRAP, n_tiles))
         base = per_rr[rrs[0]]
         row = [os.path.basename(scene)]
         for rr in rrs:
             r = per_rr[rr]
-            var_ratio = base["tiles"].sum() / r["tiles"].sum()
-            boot = base["tiles"][picks].sum(axis=1) / r["tiles"][picks].sum(axis=1)
-            se = boot.std(ddof=1)
+            var_ratio, se = tile_ratio(base["tiles"], r["tiles"], rng, BOOTSTRAP)
             rel_var = r["tiles"].sum() / (n_tiles * TILE * TILE)
             eff_s = var_ratio * base["secs"] / r["secs"]
             eff_ray = var_ratio * base["rays"] / r["rays"]

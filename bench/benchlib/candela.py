@@ -43,6 +43,16 @@ def parse_summary(stdout: str) -> Optional[re.Match]:
     return found
 
 
+def run(cmd: list, cwd: Optional[str] = None) -> re.Match:
+    """Runs a `candela render` command line and returns its summary line's match; raises
+    with candela's output if it failed or printed no summary."""
+    p = subprocess.run(cmd, cwd=cwd, capture_output=True, text=True)
+    m = parse_summary(p.stdout)
+    if p.returncode != 0 or m is None:
+        raise RuntimeError(f"{' '.join(cmd)} failed ({p.returncode}):\n{p.stderr}{p.stdout}")
+    return m
+
+
 def render(binary: str, scene: str, out: str, *, spp: int, max_depth: int, threads: int,
            res: tuple, seed: Optional[int] = None, cwd: Optional[str] = None,
            sampler: Optional[str] = None) -> CandelaRun:

@@ -49,6 +49,26 @@ def tile_sums(x: np.ndarray) -> np.ndarray:
     return x[:h, :w].reshape(h // TILE, TILE, w // TILE, TILE).sum(axis=(1, 3)).ravel()
 
 
+def relative_variances(groups: dict) -> dict:
+    """For each group of renders of one scene (a list of images differing only in their
+    seeds), the variance of one render per pixel and channel across the group, relative
+    to (m² + ε) with m the pixel's mean over every render of every group (relMSE's ε),
+    averaged over the channels: an (h, w) map per group. For unbiased renders this is
+    their whole error, measured without a reference image."""
+    mean = np.mean([img for imgs in groups.values() for img in imgs], axis=0)
+    den = mean ** 2 + RELMSE_EPS
+    return {key: (np.array(imgs).var(axis=0, ddof=1) / den).mean(axis=-1)
+            for key, imgs in groups.items()}
+
+
+def tile_ratio(num: np.ndarray, den: np.ndarray, rng, draws: int = 200) -> tuple:
+    """The ratio of two maps' sums of tile sums (`tile_sums`) and its standard error from
+    a bootstrap over the tiles (the same tiles drawn for both)."""
+    picks = rng.integers(0, len(num), size=(draws, len(num)))
+    boot = num[picks].sum(axis=1) / den[picks].sum(axis=1)
+    return num.sum() / den.sum(), boot.std(ddof=1)
+
+
 def relmse(x: np.ndarray, ref: np.ndarray) -> float:
     """Mean over pixels and channels of (x − ref)² / (ref² + ε)."""
     return float(np.mean((x - ref) ** 2 / (ref ** 2 + RELMSE_EPS)))
