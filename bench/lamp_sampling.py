@@ -12,8 +12,8 @@ Efficiency of solid angle against area = (area's variance × seconds) ÷ (solid 
 above 1, drawing near lamps in solid angle reaches a given error sooner. The variance
 ratio's standard error (±) comes from a bootstrap over 16×16-pixel tiles.
 
-Usage: bench/lamp_sampling.sh [--spp 64] [--seeds 6] [--downscale 2] [--threads 2]
-                              [--max-depth N] [--skip-build] [SCENE ...]
+Usage: bench/lamp_sampling.sh [--spp 64] [--seeds 6] [--downscale 2 | --res WxH]
+                              [--threads 2] [--max-depth N] [--skip-build] [SCENE ...]
 """
 
 import argparse
@@ -41,7 +41,10 @@ MODES = ["area", "solid-angle"]
 BOOTSTRAP = 200
 
 
-def resolution(scene: str, downscale: int) -> str:
+def resolution(scene: str, a) -> str:
+    if a.res:
+        return a.res
+    downscale = a.downscale
     with open(os.path.join(REPO, scene), "rb") as f:
         w, h = tomllib.load(f).get("render", {}).get("resolution", [512, 512])
     return f"{max(1, w // downscale)}x{max(1, h // downscale)}"
@@ -61,7 +64,9 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--spp", type=int, default=64)
     ap.add_argument("--seeds", type=int, default=6)
-    ap.add_argument("--downscale", type=int, default=2)
+    ap.add_argument("--downscale", type=int, default=2,
+                    help="divides a TOML scene's resolution")
+    ap.add_argument("--res", help="WIDTHxHEIGHT instead (needed for other formats)")
     ap.add_argument("--threads", type=int, default=2)
     ap.add_argument("--max-depth", type=int, help="override the scenes' max_depth")
     ap.add_argument("--skip-build", action="store_true")
@@ -79,7 +84,7 @@ def main() -> None:
     rng = np.random.default_rng(1)
     rows = []
     for scene in a.scenes:
-        res = resolution(scene, a.downscale)
+        res = resolution(scene, a)
         runs = {mode: [] for mode in MODES}
         for seed in range(1, a.seeds + 1):
             for mode in MODES:
