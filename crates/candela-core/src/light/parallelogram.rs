@@ -122,10 +122,11 @@ impl ParallelogramLight {
     }
 
     /// The rectangle as the spherical rectangle it covers seen from `p`, where it is near
-    /// enough to be drawn there (see [`spherical::near`]).
+    /// enough to be drawn there (see [`spherical::near`]). Not from behind, where nothing
+    /// is drawn either way.
     #[inline]
     fn spherical(&self, p: Vec3) -> Option<SphericalRectangle> {
-        if self.sampling == LampSampling::Area {
+        if self.sampling == LampSampling::Area || (p - self.p0).dot(self.n) <= 0.0 {
             return None;
         }
         let r = self.rectangle?;

@@ -104,10 +104,14 @@ impl TriangleLight {
 
     /// The triangle as the spherical triangle it covers seen from `p`, where it is near
     /// enough to be drawn there (see [`spherical::near`]) and is not textured (a texture
-    /// draws its points by its own density over the triangle).
+    /// draws its points by its own density over the triangle). Not from behind, where
+    /// nothing is drawn either way.
     #[inline]
     fn spherical(&self, p: Vec3) -> Option<SphericalTriangle> {
-        if self.sampling == LampSampling::Area || self.texture.is_some() {
+        if self.sampling == LampSampling::Area
+            || self.texture.is_some()
+            || (p - self.p[0]).dot(self.n) <= 0.0
+        {
             return None;
         }
         let centroid = (self.p[0] + self.p[1] + self.p[2]) * (1.0 / 3.0);
@@ -119,12 +123,10 @@ impl TriangleLight {
 
     pub fn sample_li(&self, ctx: &ShadingCtx, u: Vec2) -> Option<LightSample> {
         if let Some(sphere) = self.spherical(ctx.p) {
-            let h = (ctx.p - self.p[0]).dot(self.n);
-            if h <= 0.0 {
-                return None;
-            }
             let s = sphere.sample(ctx, u);
-            // The point where the drawn direction meets the triangle's plane.
+            // The point where the drawn direction meets the triangle's plane, h in front
+            // of it (`spherical` is none from behind).
+            let h = (ctx.p - self.p[0]).dot(self.n);
             let cos_l = -s.wi.dot(self.n);
             let distance = h / cos_l;
             if !positive_finite(distance) {
