@@ -250,11 +250,9 @@ pub fn build(desc: &SceneDesc) -> Result<Scene, BuildError> {
         .reduce(Aabb::union);
     let scene_radius = bounds.map_or(1.0, |b| (0.5 * (b.max - b.min).length()).max(1e-3));
     for light in &mut lights {
-        match light {
-            Light::Directional(d) => d.scene_radius = scene_radius,
-            Light::Triangle(t) => t.sampling = r.lamp_sampling,
-            Light::Parallelogram(q) => q.sampling = r.lamp_sampling,
-            _ => {}
+        light.set_lamp_sampling(r.lamp_sampling);
+        if let Light::Directional(d) = light {
+            d.scene_radius = scene_radius;
         }
     }
     if let Some(env) = &desc.environment {

@@ -44,6 +44,7 @@ pub use triangle::TriangleLight;
 
 use glam::{Vec2, Vec3};
 
+use crate::desc::LampSampling;
 use crate::geometry::Ray;
 use crate::math::luminance;
 
@@ -163,6 +164,16 @@ pub enum Light {
 }
 
 impl Light {
+    /// How next event estimation draws points on this light, where it is a flat lamp (a
+    /// triangle or a parallelogram); other lights have one way only.
+    pub fn set_lamp_sampling(&mut self, sampling: LampSampling) {
+        match self {
+            Light::Triangle(t) => t.sampling = sampling,
+            Light::Parallelogram(q) => q.sampling = sampling,
+            _ => {}
+        }
+    }
+
     #[inline]
     pub fn sample_li(&self, ctx: &ShadingCtx, u: Vec2) -> Option<LightSample> {
         let s = match self {

@@ -595,11 +595,7 @@ mod tests {
                     Vec3::ONE,
                 ))
             };
-            match &mut light {
-                Light::Parallelogram(q) => q.sampling = LampSampling::SolidAngle,
-                Light::Triangle(t) => t.sampling = LampSampling::SolidAngle,
-                _ => unreachable!(),
-            }
+            light.set_lamp_sampling(LampSampling::SolidAngle);
             // In front of the lamp, anywhere across it.
             let height = 10f32.powf(7.0 * r() - 6.0);
             let off = -n * scale * height;

@@ -401,11 +401,7 @@ mod tests {
             ),
         ] {
             let mut near = light.clone();
-            match &mut near {
-                Light::Triangle(t) => t.sampling = LampSampling::SolidAngle,
-                Light::Parallelogram(q) => q.sampling = LampSampling::SolidAngle,
-                _ => unreachable!(),
-            }
+            near.set_lamp_sampling(LampSampling::SolidAngle);
             let n = 100_000;
             let (m_area, v_area) =
                 moments(n, 3, |u| light.sample_li(&ctx, u).map_or(0.0, irradiance));
