@@ -18,7 +18,7 @@ fn data_dir() -> Option<PathBuf> {
     if dir.exists() {
         Some(dir.to_path_buf())
     } else {
-        eprintln!("skipping: ../shared/data not found");
+        eprintln!("skipped: ../shared/data not found (the optional HDR and cubemap collection)");
         None
     }
 }

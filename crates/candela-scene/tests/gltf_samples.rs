@@ -29,7 +29,7 @@ fn model(rel: &str) -> Option<PathBuf> {
     if p.exists() {
         Some(p)
     } else {
-        eprintln!("skipping: {} is absent", p.display());
+        eprintln!("skipped: ../shared/data not found ({} is absent)", p.display());
         None
     }
 }

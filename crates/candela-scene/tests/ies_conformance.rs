@@ -18,7 +18,7 @@ fn data_dir() -> Option<PathBuf> {
     if dir.is_dir() {
         Some(dir)
     } else {
-        eprintln!("skipping: ../shared/data not found");
+        eprintln!("skipped: ../shared/data not found (the optional IES conformance collection)");
         None
     }
 }

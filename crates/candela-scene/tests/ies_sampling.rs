@@ -178,7 +178,7 @@ fn emission_sampling_of_a_real_profile_follows_its_pdf() {
     let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/../../../shared/data/ies");
     let path = std::path::Path::new(dir).join("area_light.ies");
     if !path.exists() {
-        eprintln!("skipping: ../shared/data not found");
+        eprintln!("skipped: ../shared/data not found (the optional IES conformance collection)");
         return;
     }
     // area_light.ies: asymmetric street light, bilateral 0–180° planes, 0–180° vertical.

@@ -32,7 +32,7 @@ fn data_dir() -> Option<&'static Path> {
     if p.is_dir() {
         Some(p)
     } else {
-        eprintln!("skipping: ../shared/data not found");
+        eprintln!("skipped: ../shared/data not found (the optional Mitsuba scenes and reference renders)");
         None
     }
 }
