@@ -2,7 +2,7 @@
 
 use std::path::Path;
 
-use candela_core::light::{EnvironmentLight, EnvironmentMap, Light};
+use candela_core::light::{EnvironmentLight, EnvironmentMap, Light, LightSource};
 
 use crate::render::LoadArgs;
 use crate::UserError;

@@ -13,7 +13,7 @@ use crate::desc::{MisMode, SamplerKind};
 use crate::film::{Film, Pixel};
 use crate::filter::PixelFilter;
 use crate::geometry::Ray;
-use crate::light::{Light, LightId, LightSample, ShadingCtx};
+use crate::light::{Light, LightId, LightSample, LightSource, ShadingCtx};
 use crate::light_sampler::LightPick;
 use crate::math::max_component;
 use crate::sampler::{IndependentSampler, Sampler, SobolCmjSampler, SobolSampler};

@@ -10,7 +10,7 @@ use std::f32::consts::PI;
 
 use candela_core::chi2::{sidak_alpha, ChiSquareTest};
 use candela_core::light::envmap::{cubemap, equirect, Cubemap, Equirect, Image};
-use candela_core::light::{EnvironmentLight, EnvironmentMap, ShadingCtx};
+use candela_core::light::{EnvironmentLight, EnvironmentMap, LightSource, ShadingCtx};
 use glam::{Mat3, Vec2, Vec3};
 
 /// Chi-square tests in this file, for the Šidák correction.

@@ -8,7 +8,7 @@ use candela_core::chi2::{sidak_alpha, ChiSquareTest};
 use candela_core::color::srgb_decode;
 use candela_core::desc::{EnvironmentMapDesc, ImageDesc};
 use candela_core::light::envmap::{cubemap, Cubemap, Equirect, Image};
-use candela_core::light::{EnvironmentLight, EnvironmentMap, ShadingCtx};
+use candela_core::light::{EnvironmentLight, EnvironmentMap, LightSource, ShadingCtx};
 use candela_scene::environment::load_linear_image;
 use candela_scene::parse_toml_scene;
 use glam::{Mat3, Vec3};

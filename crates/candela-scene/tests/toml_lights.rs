@@ -7,7 +7,7 @@ use std::path::{Path, PathBuf};
 
 use candela_core::build::build;
 use candela_core::desc::*;
-use candela_core::light::Light;
+use candela_core::light::{Light, LightSource};
 use candela_scene::{load_scene, parse_toml_scene};
 use glam::{Vec2, Vec3};
 

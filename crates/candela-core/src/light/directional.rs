@@ -1,8 +1,8 @@
 use std::f32::consts::PI;
 
-use glam::Vec3;
+use glam::{Vec2, Vec3};
 
-use super::{receiver_cos, LightSample, ShadingCtx};
+use super::{receiver_cos, LightBounds, LightFlags, LightSample, LightSource, ShadingCtx};
 use crate::math::luminance;
 
 /// Parallel light from infinitely far away, travelling along `direction`: a surface facing
@@ -17,8 +17,12 @@ pub struct DirectionalLight {
     pub scene_radius: f32,
 }
 
-impl DirectionalLight {
-    pub fn sample_li(&self, ctx: &ShadingCtx) -> Option<LightSample> {
+impl DirectionalLight {}
+
+impl LightSource for DirectionalLight {
+    const FLAGS: LightFlags = LightFlags::DELTA_DIRECTION;
+
+    fn sample_li(&self, ctx: &ShadingCtx, _u: Vec2) -> Option<LightSample> {
         let wi = -self.direction;
         Some(LightSample {
             radiance: self.irradiance,
@@ -32,12 +36,17 @@ impl DirectionalLight {
     }
 
     /// E × the receiver cosine towards the light.
-    pub fn importance(&self, ctx: &ShadingCtx) -> f32 {
+    fn importance(&self, ctx: &ShadingCtx) -> f32 {
         luminance(self.irradiance) * receiver_cos(ctx, -self.direction)
     }
 
     /// The power crossing the scene's bounding disk, Φ = π r² E (pbrt-v4 §12.4).
-    pub fn power(&self) -> f32 {
+    fn power(&self) -> f32 {
         PI * self.scene_radius * self.scene_radius * luminance(self.irradiance)
+    }
+
+    /// Not bounded in space: the BVH sampler picks it apart from the tree.
+    fn bounds(&self) -> Option<LightBounds> {
+        None
     }
 }

@@ -8,7 +8,7 @@ use std::f32::consts::PI;
 use glam::{Mat3, Vec2, Vec3};
 
 use super::envmap::{Cubemap, Equirect};
-use super::{LightSample, ShadingCtx};
+use super::{LightBounds, LightFlags, LightSample, LightSource, ShadingCtx};
 use crate::geometry::Ray;
 use crate::math::luminance;
 use crate::sampling::sample_uniform_sphere;
@@ -83,11 +83,6 @@ impl EnvironmentLight {
             }
     }
 
-    /// Radiance along an escaped ray.
-    pub fn le(&self, ray: &Ray) -> Vec3 {
-        self.eval(ray.d.normalize())
-    }
-
     /// What a camera ray that escapes sees: the map, or the background when hidden.
     pub fn le_camera(&self, ray: &Ray) -> Vec3 {
         if self.visible {
@@ -95,51 +90,6 @@ impl EnvironmentLight {
         } else {
             self.background
         }
-    }
-
-    pub fn sample_li(&self, _ctx: &ShadingCtx, u: Vec2) -> Option<LightSample> {
-        let (local, pdf) = match (&self.map, self.sampling) {
-            (EnvironmentMap::Constant(_), _) | (_, EnvironmentSampling::Uniform) => {
-                (sample_uniform_sphere(u), 1.0 / (4.0 * PI))
-            }
-            (EnvironmentMap::Equirect(m), _) => m.sample(u)?,
-            (EnvironmentMap::Cubemap(m), _) => m.sample(u)?,
-        };
-        let wi = (self.world_from_map * local).normalize();
-        Some(LightSample {
-            radiance: self.eval(wi),
-            wi,
-            distance: f32::INFINITY,
-            pdf,
-            is_delta: false,
-            p_light: wi,
-            n_light: Vec3::ZERO,
-        })
-    }
-
-    pub fn pdf_li(&self, _ctx: &ShadingCtx, wi: Vec3) -> f32 {
-        let local = self.map_from_world * wi.normalize();
-        match (&self.map, self.sampling) {
-            (EnvironmentMap::Constant(_), _) | (_, EnvironmentSampling::Uniform) => {
-                1.0 / (4.0 * PI)
-            }
-            (EnvironmentMap::Equirect(m), _) => m.pdf(local),
-            (EnvironmentMap::Cubemap(m), _) => m.pdf(local),
-        }
-    }
-
-    /// Power Φ the scene receives: as pbrt-v4's `ImageInfiniteLight::Phi`, the flux
-    /// through a disk of the scene's bounding radius r, averaged over orientations,
-    /// Φ = π r² ∫ L dω (luminance-weighted).
-    pub fn power(&self) -> f32 {
-        PI * self.scene_radius * self.scene_radius * self.luminance_integral
-    }
-
-    /// Potential contribution at any point, for light selection: ∫ L dω over the sphere
-    /// (solid angle × brightness, with the receiver cosine bounded by 1), as for the
-    /// other lights' `importance`.
-    pub fn importance(&self) -> f32 {
-        self.luminance_integral
     }
 
     /// Fraction of the map's power (luminance × texel solid angle) carried by its
@@ -177,5 +127,64 @@ impl EnvironmentLight {
         power.sort_unstable_by(|a, b| b.total_cmp(a));
         let k = ((fraction.clamp(0.0, 1.0) * power.len() as f32).ceil() as usize).max(1);
         (power[..k].iter().map(|&p| p as f64).sum::<f64>() / total) as f32
+    }
+}
+
+impl LightSource for EnvironmentLight {
+    const FLAGS: LightFlags = LightFlags::INFINITE;
+
+    /// Radiance along an escaped ray.
+    fn le(&self, ray: &Ray) -> Vec3 {
+        self.eval(ray.d.normalize())
+    }
+
+    fn sample_li(&self, _ctx: &ShadingCtx, u: Vec2) -> Option<LightSample> {
+        let (local, pdf) = match (&self.map, self.sampling) {
+            (EnvironmentMap::Constant(_), _) | (_, EnvironmentSampling::Uniform) => {
+                (sample_uniform_sphere(u), 1.0 / (4.0 * PI))
+            }
+            (EnvironmentMap::Equirect(m), _) => m.sample(u)?,
+            (EnvironmentMap::Cubemap(m), _) => m.sample(u)?,
+        };
+        let wi = (self.world_from_map * local).normalize();
+        Some(LightSample {
+            radiance: self.eval(wi),
+            wi,
+            distance: f32::INFINITY,
+            pdf,
+            is_delta: false,
+            p_light: wi,
+            n_light: Vec3::ZERO,
+        })
+    }
+
+    fn pdf_li(&self, _ctx: &ShadingCtx, wi: Vec3) -> f32 {
+        let local = self.map_from_world * wi.normalize();
+        match (&self.map, self.sampling) {
+            (EnvironmentMap::Constant(_), _) | (_, EnvironmentSampling::Uniform) => {
+                1.0 / (4.0 * PI)
+            }
+            (EnvironmentMap::Equirect(m), _) => m.pdf(local),
+            (EnvironmentMap::Cubemap(m), _) => m.pdf(local),
+        }
+    }
+
+    /// Power Φ the scene receives: as pbrt-v4's `ImageInfiniteLight::Phi`, the flux
+    /// through a disk of the scene's bounding radius r, averaged over orientations,
+    /// Φ = π r² ∫ L dω (luminance-weighted).
+    fn power(&self) -> f32 {
+        PI * self.scene_radius * self.scene_radius * self.luminance_integral
+    }
+
+    /// Potential contribution at any point, for light selection: ∫ L dω over the sphere
+    /// (solid angle × brightness, with the receiver cosine bounded by 1), as for the
+    /// other lights' `importance`.
+    fn importance(&self, _ctx: &ShadingCtx) -> f32 {
+        self.luminance_integral
+    }
+
+    /// Infinite: the BVH sampler picks it apart from the tree.
+    fn bounds(&self) -> Option<LightBounds> {
+        None
     }
 }

@@ -1,6 +1,8 @@
 use glam::{Vec2, Vec3};
 
-use super::{positional, LightBounds, LightProfile, LightSample, ShadingCtx};
+use super::{
+    positional, LightBounds, LightFlags, LightProfile, LightSample, LightSource, ShadingCtx,
+};
 use crate::geometry::Aabb;
 use crate::math::luminance;
 
@@ -20,33 +22,6 @@ impl GoniometricLight {
         self.intensity * self.profile.relative(w)
     }
 
-    pub fn sample_li(&self, ctx: &ShadingCtx) -> Option<LightSample> {
-        positional::sample_li(self.position, ctx, |w| self.intensity_towards(w))
-    }
-
-    /// The exact potential contribution: luminance of I(ω)/d² towards `ctx` times the
-    /// receiver cosine; exactly 0 where the light is dark towards the point.
-    pub fn importance(&self, ctx: &ShadingCtx) -> f32 {
-        positional::importance(self.position, ctx, |w| self.intensity_towards(w))
-    }
-
-    /// Bounded like a point light emitting everywhere at the profile's peak.
-    pub fn bounds(&self) -> LightBounds {
-        LightBounds {
-            aabb: Aabb::from_points(&[self.position]),
-            w: self.profile.frame.n,
-            intensity: luminance(self.intensity),
-            cos_theta_o: -1.0,
-            cos_theta_e: 0.0,
-            two_sided: false,
-        }
-    }
-
-    /// Φ = I_peak · ∫ I/I_max dω.
-    pub fn power(&self) -> f32 {
-        luminance(self.intensity) * self.profile.solid_angle()
-    }
-
     /// An emission direction drawn from the profile table, with its solid-angle density.
     pub fn sample_emission(&self, u: Vec2) -> Option<(Vec3, f32)> {
         let (w, pdf) = self.profile.sample(u);
@@ -56,5 +31,36 @@ impl GoniometricLight {
     /// Density of [`Self::sample_emission`].
     pub fn emission_pdf(&self, w: Vec3) -> f32 {
         self.profile.pdf(w)
+    }
+}
+
+impl LightSource for GoniometricLight {
+    const FLAGS: LightFlags = LightFlags::DELTA_POSITION;
+
+    fn sample_li(&self, ctx: &ShadingCtx, _u: Vec2) -> Option<LightSample> {
+        positional::sample_li(self.position, ctx, |w| self.intensity_towards(w))
+    }
+
+    /// The exact potential contribution: luminance of I(ω)/d² towards `ctx` times the
+    /// receiver cosine; exactly 0 where the light is dark towards the point.
+    fn importance(&self, ctx: &ShadingCtx) -> f32 {
+        positional::importance(self.position, ctx, |w| self.intensity_towards(w))
+    }
+
+    /// Bounded like a point light emitting everywhere at the profile's peak.
+    fn bounds(&self) -> Option<LightBounds> {
+        Some(LightBounds {
+            aabb: Aabb::from_points(&[self.position]),
+            w: self.profile.frame.n,
+            intensity: luminance(self.intensity),
+            cos_theta_o: -1.0,
+            cos_theta_e: 0.0,
+            two_sided: false,
+        })
+    }
+
+    /// Φ = I_peak · ∫ I/I_max dω.
+    fn power(&self) -> f32 {
+        luminance(self.intensity) * self.profile.solid_angle()
     }
 }

@@ -7,9 +7,12 @@
 //! - **radiance** ([`Light::radiance`] when a ray hits an area light, [`Light::le`] when
 //!   a ray escapes to an infinite light).
 //!
-//! All densities are in solid angle at the shading point. Delta lights (points, spots,
-//! goniometric, directional and projector lights) report
-//! `pdf = 1` and `is_delta`, and are never hit by rays.
+//! The interface is written once, in [`LightSource`] (`source.rs`): every variant of
+//! [`Light`] implements it with the same signatures and says what it is through
+//! [`LightFlags`] (delta position, delta direction, surface, infinite); [`Light`] only
+//! dispatches. All densities are in solid angle at the shading point. Delta lights
+//! (points, spots, goniometric, directional and projector lights) report `pdf = 1` and
+//! `is_delta`, and are never hit by rays.
 
 pub mod blackbody;
 mod bounds;
@@ -23,6 +26,7 @@ mod point;
 mod positional;
 mod profile;
 mod projector;
+mod source;
 mod sphere;
 mod spherical;
 mod spot;
@@ -37,6 +41,7 @@ pub use parallelogram::ParallelogramLight;
 pub use point::PointLight;
 pub use profile::LightProfile;
 pub use projector::ProjectorLight;
+pub use source::{LightFlags, LightSource};
 pub use sphere::SphereLight;
 pub use spherical::polygon_irradiance;
 pub use spot::SpotLight;
@@ -150,6 +155,25 @@ impl LightSample {
     }
 }
 
+/// Calls the same [`LightSource`] method on whichever light `$light` holds.
+macro_rules! dispatch {
+    ($light:expr, $l:ident => $call:expr) => {
+        match $light {
+            Light::Point($l) => $call,
+            Light::Triangle($l) => $call,
+            Light::Parallelogram($l) => $call,
+            Light::Sphere($l) => $call,
+            Light::Spot($l) => $call,
+            Light::Goniometric($l) => $call,
+            Light::Directional($l) => $call,
+            Light::Projector($l) => $call,
+            Light::Environment($l) => $call,
+        }
+    };
+}
+
+/// Every light Candela has: a closed enum on the hot path, each variant a
+/// [`LightSource`].
 #[derive(Clone, Debug)]
 pub enum Light {
     Point(PointLight),
@@ -174,61 +198,35 @@ impl Light {
         }
     }
 
+    /// What kind of emitter this is.
+    #[inline]
+    pub fn flags(&self) -> LightFlags {
+        dispatch!(self, l => flags_of(l))
+    }
+
+    /// A direction towards the light, with the radiance arriving along it and its
+    /// density; `None` unless the sample carries light with a positive, finite density.
     #[inline]
     pub fn sample_li(&self, ctx: &ShadingCtx, u: Vec2) -> Option<LightSample> {
-        let s = match self {
-            Light::Point(l) => l.sample_li(ctx),
-            Light::Triangle(l) => l.sample_li(ctx, u),
-            Light::Parallelogram(l) => l.sample_li(ctx, u),
-            Light::Sphere(l) => l.sample_li(ctx, u),
-            Light::Spot(l) => l.sample_li(ctx),
-            Light::Goniometric(l) => l.sample_li(ctx),
-            Light::Directional(l) => l.sample_li(ctx),
-            Light::Projector(l) => l.sample_li(ctx),
-            Light::Environment(l) => l.sample_li(ctx, u),
-        }?;
-        s.usable()
+        dispatch!(self, l => l.sample_li(ctx, u))?.usable()
     }
 
     /// Density in solid angle with which [`Self::sample_li`] picks direction `wi` at `ctx`.
     #[inline]
     pub fn pdf_li(&self, ctx: &ShadingCtx, wi: Vec3) -> f32 {
-        match self {
-            Light::Point(_)
-            | Light::Spot(_)
-            | Light::Goniometric(_)
-            | Light::Directional(_)
-            | Light::Projector(_) => 0.0,
-            Light::Triangle(l) => l.pdf_li(ctx, wi),
-            Light::Parallelogram(l) => l.pdf_li(ctx, wi),
-            Light::Sphere(l) => l.pdf_li(ctx, wi),
-            Light::Environment(l) => l.pdf_li(ctx, wi),
-        }
+        dispatch!(self, l => l.pdf_li(ctx, wi))
     }
 
     /// Radiance leaving an area light at a point with geometric normal `n` and texture
     /// coordinates `uv` in direction `w`.
     #[inline]
     pub fn radiance(&self, n: Vec3, uv: Vec2, w: Vec3) -> Vec3 {
-        match self {
-            Light::Point(_)
-            | Light::Spot(_)
-            | Light::Goniometric(_)
-            | Light::Directional(_)
-            | Light::Projector(_)
-            | Light::Environment(_) => Vec3::ZERO,
-            Light::Triangle(l) => l.radiance(n, uv, w),
-            Light::Parallelogram(l) => l.radiance(n, w),
-            Light::Sphere(l) => l.radiance(n, w),
-        }
+        dispatch!(self, l => l.radiance(n, uv, w))
     }
 
     /// Radiance an infinite light sends along an escaped ray.
     pub fn le(&self, ray: &Ray) -> Vec3 {
-        match self {
-            Light::Environment(l) => l.le(ray),
-            _ => Vec3::ZERO,
-        }
+        dispatch!(self, l => l.le(ray))
     }
 
     /// What an escaped camera ray sees of an infinite light: [`Self::le`], unless the
@@ -242,17 +240,7 @@ impl Light {
 
     /// Total emitted power Φ, as a luminance-weighted scalar (W).
     pub fn power(&self) -> f32 {
-        match self {
-            Light::Point(l) => l.power(),
-            Light::Triangle(l) => l.power(),
-            Light::Parallelogram(l) => l.power(),
-            Light::Sphere(l) => l.power(),
-            Light::Spot(l) => l.power(),
-            Light::Goniometric(l) => l.power(),
-            Light::Directional(l) => l.power(),
-            Light::Projector(l) => l.power(),
-            Light::Environment(l) => l.power(),
-        }
+        dispatch!(self, l => l.power())
     }
 
     /// Potential contribution at `ctx` up to a common constant, for choosing among lights
@@ -261,51 +249,31 @@ impl Light {
     /// that a BSDF could scatter, e.g. a point behind a one-sided emitter; the receiver
     /// cosine is taken in absolute value so that transmitting BSDFs are not cut off.
     pub fn importance(&self, ctx: &ShadingCtx) -> f32 {
-        match self {
-            Light::Point(l) => l.importance(ctx),
-            Light::Triangle(l) => l.importance(ctx),
-            Light::Parallelogram(l) => l.importance(ctx),
-            Light::Sphere(l) => l.importance(ctx),
-            Light::Spot(l) => l.importance(ctx),
-            Light::Goniometric(l) => l.importance(ctx),
-            Light::Directional(l) => l.importance(ctx),
-            Light::Projector(l) => l.importance(ctx),
-            Light::Environment(l) => l.importance(),
-        }
+        dispatch!(self, l => l.importance(ctx))
     }
 
     /// Bounds for the light BVH; `None` for lights that are not bounded in space (infinite
     /// lights), which the BVH sampler picks apart from the tree.
     pub fn bounds(&self) -> Option<LightBounds> {
-        match self {
-            Light::Point(l) => Some(l.bounds()),
-            Light::Triangle(l) => Some(l.bounds()),
-            Light::Parallelogram(l) => Some(l.bounds()),
-            Light::Sphere(l) => Some(l.bounds()),
-            Light::Spot(l) => Some(l.bounds()),
-            Light::Goniometric(l) => Some(l.bounds()),
-            Light::Projector(l) => Some(l.bounds()),
-            Light::Directional(_) => None,
-            Light::Environment(_) => None,
-        }
+        dispatch!(self, l => l.bounds())
     }
 
+    /// Whether the light is a delta in position or direction (see [`LightFlags`]).
     #[inline]
     pub fn is_delta(&self) -> bool {
-        matches!(
-            self,
-            Light::Point(_)
-                | Light::Spot(_)
-                | Light::Goniometric(_)
-                | Light::Directional(_)
-                | Light::Projector(_)
-        )
+        self.flags().is_delta()
     }
 
     /// Whether escaped rays see this light (environment lights).
     pub fn is_infinite(&self) -> bool {
-        matches!(self, Light::Environment(_))
+        self.flags().contains(LightFlags::INFINITE)
     }
+}
+
+/// A variant's [`LightSource::FLAGS`], through a value.
+#[inline(always)]
+fn flags_of<L: LightSource>(_: &L) -> LightFlags {
+    L::FLAGS
 }
 
 #[cfg(test)]

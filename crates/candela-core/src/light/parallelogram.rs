@@ -1,8 +1,11 @@
 use glam::{Vec2, Vec3};
 
+use super::source::one_sided;
 use super::spherical::{self, SphericalRectangle};
 use super::triangle::solid_angle;
-use super::{flat_importance, LightBounds, LightSample, ShadingCtx, TriangleLight};
+use super::{
+    flat_importance, LightBounds, LightFlags, LightSample, LightSource, ShadingCtx, TriangleLight,
+};
 use crate::desc::LampSampling;
 use crate::geometry::Aabb;
 use crate::math::luminance;
@@ -137,8 +140,21 @@ impl ParallelogramLight {
         SphericalRectangle::new(p, self.p0, r.x, r.y, r.lx, r.ly)
     }
 
+    fn corners(&self) -> [Vec3; 4] {
+        [
+            self.p0,
+            self.p0 + self.e1,
+            self.p0 + self.e1 + self.e2,
+            self.p0 + self.e2,
+        ]
+    }
+}
+
+impl LightSource for ParallelogramLight {
+    const FLAGS: LightFlags = LightFlags::SURFACE;
+
     #[inline]
-    pub fn sample_li(&self, ctx: &ShadingCtx, u: Vec2) -> Option<LightSample> {
+    fn sample_li(&self, ctx: &ShadingCtx, u: Vec2) -> Option<LightSample> {
         if let Some(sphere) = self.spherical(ctx.p) {
             let (q, pdf) = sphere.sample(ctx, u);
             return LightSample::uniform_area(ctx.p, q, self.n, self.area, |_| self.le)
@@ -149,7 +165,7 @@ impl ParallelogramLight {
     }
 
     #[inline]
-    pub fn pdf_li(&self, ctx: &ShadingCtx, wi: Vec3) -> f32 {
+    fn pdf_li(&self, ctx: &ShadingCtx, wi: Vec3) -> f32 {
         let cos_l = -wi.dot(self.n);
         if cos_l <= 0.0 {
             return 0.0;
@@ -171,31 +187,18 @@ impl ParallelogramLight {
     }
 
     #[inline]
-    pub fn radiance(&self, n: Vec3, w: Vec3) -> Vec3 {
-        if n.dot(w) > 0.0 {
-            self.le
-        } else {
-            Vec3::ZERO
-        }
+    fn radiance(&self, n: Vec3, _uv: Vec2, w: Vec3) -> Vec3 {
+        one_sided(n, w, self.le)
     }
 
     /// Φ = π · A · L for a one-sided Lambertian emitter.
-    pub fn power(&self) -> f32 {
+    fn power(&self) -> f32 {
         std::f32::consts::PI * self.area * luminance(self.le)
-    }
-
-    fn corners(&self) -> [Vec3; 4] {
-        [
-            self.p0,
-            self.p0 + self.e1,
-            self.p0 + self.e1 + self.e2,
-            self.p0 + self.e2,
-        ]
     }
 
     /// As [`TriangleLight::importance`], with the solid angle of the two triangles
     /// (p₀, p₁, p₂) and (p₀, p₂, p₃) summed.
-    pub fn importance(&self, ctx: &ShadingCtx) -> f32 {
+    fn importance(&self, ctx: &ShadingCtx) -> f32 {
         if (ctx.p - self.p0).dot(self.n) <= 0.0 {
             return 0.0;
         }
@@ -207,15 +210,15 @@ impl ParallelogramLight {
 
     /// One-sided Lambertian emitter: normal cone of zero width, emission up to 90°;
     /// peak intensity L·A along the normal.
-    pub fn bounds(&self) -> LightBounds {
-        LightBounds {
+    fn bounds(&self) -> Option<LightBounds> {
+        Some(LightBounds {
             aabb: Aabb::from_points(&self.corners()),
             w: self.n,
             intensity: luminance(self.le) * self.area,
             cos_theta_o: 1.0,
             cos_theta_e: 0.0,
             two_sided: false,
-        }
+        })
     }
 }
 

@@ -1,8 +1,8 @@
 use std::f32::consts::PI;
 
-use glam::Vec3;
+use glam::{Vec2, Vec3};
 
-use super::{receiver_cos, LightBounds, LightSample, ShadingCtx};
+use super::{receiver_cos, LightBounds, LightFlags, LightSample, LightSource, ShadingCtx};
 use crate::geometry::Aabb;
 use crate::math::luminance;
 
@@ -13,8 +13,10 @@ pub struct PointLight {
     pub intensity: Vec3,
 }
 
-impl PointLight {
-    pub fn sample_li(&self, ctx: &ShadingCtx) -> Option<LightSample> {
+impl LightSource for PointLight {
+    const FLAGS: LightFlags = LightFlags::DELTA_POSITION;
+
+    fn sample_li(&self, ctx: &ShadingCtx, _u: Vec2) -> Option<LightSample> {
         let to = self.position - ctx.p;
         let d2 = to.length_squared();
         if d2 == 0.0 {
@@ -32,12 +34,12 @@ impl PointLight {
         })
     }
 
-    pub fn power(&self) -> f32 {
+    fn power(&self) -> f32 {
         4.0 * PI * luminance(self.intensity)
     }
 
     /// I/d² × |cos θ| at the receiver.
-    pub fn importance(&self, ctx: &ShadingCtx) -> f32 {
+    fn importance(&self, ctx: &ShadingCtx) -> f32 {
         let to = self.position - ctx.p;
         let d2 = to.length_squared();
         if d2 == 0.0 {
@@ -47,14 +49,14 @@ impl PointLight {
     }
 
     /// A point emitting into every direction.
-    pub fn bounds(&self) -> LightBounds {
-        LightBounds {
+    fn bounds(&self) -> Option<LightBounds> {
+        Some(LightBounds {
             aabb: Aabb::from_points(&[self.position]),
             w: Vec3::Z,
             intensity: luminance(self.intensity),
             cos_theta_o: -1.0,
             cos_theta_e: 0.0,
             two_sided: false,
-        }
+        })
     }
 }

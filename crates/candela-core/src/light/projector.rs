@@ -4,7 +4,7 @@ use std::sync::Arc;
 
 use glam::{Vec2, Vec3};
 
-use super::{positional, LightBounds, LightSample, ShadingCtx};
+use super::{positional, LightBounds, LightFlags, LightSample, LightSource, ShadingCtx};
 use crate::desc::ImageDesc;
 use crate::geometry::Aabb;
 use crate::math::luminance;
@@ -150,21 +150,25 @@ impl ProjectorLight {
             }),
         }
     }
+}
 
-    pub fn sample_li(&self, ctx: &ShadingCtx) -> Option<LightSample> {
+impl LightSource for ProjectorLight {
+    const FLAGS: LightFlags = LightFlags::DELTA_POSITION;
+
+    fn sample_li(&self, ctx: &ShadingCtx, _u: Vec2) -> Option<LightSample> {
         positional::sample_li(self.position, ctx, |w| self.intensity_towards(w))
     }
 
     /// The exact potential contribution: luminance of I(ω)/d² towards `ctx` times the
     /// receiver cosine; exactly 0 where the light is dark towards the point.
-    pub fn importance(&self, ctx: &ShadingCtx) -> f32 {
+    fn importance(&self, ctx: &ShadingCtx) -> f32 {
         positional::importance(self.position, ctx, |w| self.intensity_towards(w))
     }
 
     /// Emission within the cone through the frustum's corners (θ_o), nothing beyond
     /// (θ_e = 0), at most the brightest pixel (for Mitsuba's projection, times π/cos³
     /// at the corners, where it is largest).
-    pub fn bounds(&self) -> LightBounds {
+    fn bounds(&self) -> Option<LightBounds> {
         let cos_corner = 1.0 / (1.0 + self.tan_x * self.tan_x + self.tan_y * self.tan_y).sqrt();
         let pixel_peak = self
             .image
@@ -176,18 +180,18 @@ impl ProjectorLight {
             None => pixel_peak,
             Some(_) => pixel_peak * std::f32::consts::PI / cos_corner.powi(3),
         };
-        LightBounds {
+        Some(LightBounds {
             aabb: Aabb::from_points(&[self.position]),
             w: self.forward,
             intensity: peak,
             cos_theta_o: cos_corner,
             cos_theta_e: 1.0,
             two_sided: false,
-        }
+        })
     }
 
     /// Φ = luminance(scale · ∫ image dω), the pixel solid angles taken exactly.
-    pub fn power(&self) -> f32 {
+    fn power(&self) -> f32 {
         luminance(self.scale * self.image_integral)
     }
 }

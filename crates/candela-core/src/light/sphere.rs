@@ -2,7 +2,8 @@ use std::f32::consts::PI;
 
 use glam::{Vec2, Vec3};
 
-use super::{LightBounds, LightSample, ShadingCtx};
+use super::source::one_sided;
+use super::{LightBounds, LightFlags, LightSample, LightSource, ShadingCtx};
 use crate::geometry::Aabb;
 use crate::geometry::{intersect_sphere, Ray};
 use crate::math::{luminance, Frame};
@@ -30,8 +31,12 @@ impl SphereLight {
     fn area(&self) -> f32 {
         4.0 * PI * self.radius * self.radius
     }
+}
 
-    pub fn sample_li(&self, ctx: &ShadingCtx, u: Vec2) -> Option<LightSample> {
+impl LightSource for SphereLight {
+    const FLAGS: LightFlags = LightFlags::SURFACE;
+
+    fn sample_li(&self, ctx: &ShadingCtx, u: Vec2) -> Option<LightSample> {
         if let Some(cos_max) = self.sees_outside(ctx.p) {
             let axis = (self.center - ctx.p).normalize();
             let local = sample_uniform_cone(u, cos_max);
@@ -77,7 +82,7 @@ impl SphereLight {
         })
     }
 
-    pub fn pdf_li(&self, ctx: &ShadingCtx, wi: Vec3) -> f32 {
+    fn pdf_li(&self, ctx: &ShadingCtx, wi: Vec3) -> f32 {
         if let Some(cos_max) = self.sees_outside(ctx.p) {
             let axis = (self.center - ctx.p).normalize();
             return if wi.dot(axis) >= cos_max {
@@ -101,21 +106,17 @@ impl SphereLight {
         t * t / (cos_l * self.area())
     }
 
-    pub fn radiance(&self, n: Vec3, w: Vec3) -> Vec3 {
-        if n.dot(w) > 0.0 {
-            self.le
-        } else {
-            Vec3::ZERO
-        }
+    fn radiance(&self, n: Vec3, _uv: Vec2, w: Vec3) -> Vec3 {
+        one_sided(n, w, self.le)
     }
 
-    pub fn power(&self) -> f32 {
+    fn power(&self) -> f32 {
         PI * self.area() * luminance(self.le)
     }
 
     /// Seen from outside: L × the subtended solid angle 2π(1 − cos θ_max) × the largest
     /// |cos| at the receiver over that cone. Inside (or emitting inwards): L × 4π.
-    pub fn importance(&self, ctx: &ShadingCtx) -> f32 {
+    fn importance(&self, ctx: &ShadingCtx) -> f32 {
         let lum = luminance(self.le);
         let Some(cos_max) = self.sees_outside(ctx.p) else {
             return lum * 4.0 * PI;
@@ -135,9 +136,9 @@ impl SphereLight {
     }
 
     /// Normals in every direction; peak intensity L·πr² (the projected disk).
-    pub fn bounds(&self) -> LightBounds {
+    fn bounds(&self) -> Option<LightBounds> {
         let r = Vec3::splat(self.radius);
-        LightBounds {
+        Some(LightBounds {
             aabb: Aabb {
                 min: self.center - r,
                 max: self.center + r,
@@ -147,6 +148,6 @@ impl SphereLight {
             cos_theta_o: -1.0,
             cos_theta_e: 0.0,
             two_sided: false,
-        }
+        })
     }
 }

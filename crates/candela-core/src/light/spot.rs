@@ -5,7 +5,9 @@ use std::f32::consts::PI;
 
 use glam::{Vec2, Vec3};
 
-use super::{positional, LightBounds, LightProfile, LightSample, ShadingCtx};
+use super::{
+    positional, LightBounds, LightFlags, LightProfile, LightSample, LightSource, ShadingCtx,
+};
 use crate::desc::SpotFalloff;
 use crate::geometry::Aabb;
 use crate::math::{luminance, Frame};
@@ -95,10 +97,6 @@ impl SpotLight {
         self.intensity * (f * p)
     }
 
-    pub fn sample_li(&self, ctx: &ShadingCtx) -> Option<LightSample> {
-        positional::sample_li(self.position, ctx, |w| self.intensity_towards(w))
-    }
-
     /// Whether the light can send anything towards `p`: false outside the outer cone.
     pub fn reaches(&self, p: Vec3) -> bool {
         let w = (p - self.position).normalize_or_zero();
@@ -108,30 +106,6 @@ impl SpotLight {
     /// ∫ f p dω (sr): the solid angle that turns the axis intensity into a power.
     pub fn solid_angle(&self) -> f32 {
         self.solid_angle
-    }
-
-    /// The exact potential contribution: luminance of I(ω)/d² towards `ctx` times the
-    /// receiver cosine; exactly 0 where the light is dark towards the point.
-    pub fn importance(&self, ctx: &ShadingCtx) -> f32 {
-        positional::importance(self.position, ctx, |w| self.intensity_towards(w))
-    }
-
-    /// pbrt-v4's spotlight bounds (§12.6.3): full intensity within the inner cone
-    /// (θ_o = θ_i) and emission reaching θ_o − θ_i further (θ_e). A profile only darkens.
-    pub fn bounds(&self) -> LightBounds {
-        LightBounds {
-            aabb: Aabb::from_points(&[self.position]),
-            w: self.frame.n,
-            intensity: luminance(self.intensity),
-            cos_theta_o: self.cos_inner,
-            cos_theta_e: (self.outer - self.inner).cos(),
-            two_sided: false,
-        }
-    }
-
-    /// Φ = I_axis · ∫ f p dω.
-    pub fn power(&self) -> f32 {
-        luminance(self.intensity) * self.solid_angle
     }
 
     /// ∫ f dω in closed form: 2π [(1 − cos θ_i) + ∫_{cos θ_o}^{cos θ_i} f dx], where the
@@ -228,5 +202,37 @@ impl SpotLight {
         } else {
             0.0
         }
+    }
+}
+
+impl LightSource for SpotLight {
+    const FLAGS: LightFlags = LightFlags::DELTA_POSITION;
+
+    fn sample_li(&self, ctx: &ShadingCtx, _u: Vec2) -> Option<LightSample> {
+        positional::sample_li(self.position, ctx, |w| self.intensity_towards(w))
+    }
+
+    /// The exact potential contribution: luminance of I(ω)/d² towards `ctx` times the
+    /// receiver cosine; exactly 0 where the light is dark towards the point.
+    fn importance(&self, ctx: &ShadingCtx) -> f32 {
+        positional::importance(self.position, ctx, |w| self.intensity_towards(w))
+    }
+
+    /// pbrt-v4's spotlight bounds (§12.6.3): full intensity within the inner cone
+    /// (θ_o = θ_i) and emission reaching θ_o − θ_i further (θ_e). A profile only darkens.
+    fn bounds(&self) -> Option<LightBounds> {
+        Some(LightBounds {
+            aabb: Aabb::from_points(&[self.position]),
+            w: self.frame.n,
+            intensity: luminance(self.intensity),
+            cos_theta_o: self.cos_inner,
+            cos_theta_e: (self.outer - self.inner).cos(),
+            two_sided: false,
+        })
+    }
+
+    /// Φ = I_axis · ∫ f p dω.
+    fn power(&self) -> f32 {
+        luminance(self.intensity) * self.solid_angle
     }
 }

@@ -4,8 +4,8 @@ use glam::{Vec2, Vec3};
 
 use super::spherical::{self, SphericalTriangle};
 use super::{
-    flat_importance, positive_finite, EmissionTexture, LightBounds, LightProfile, LightSample,
-    ShadingCtx,
+    flat_importance, positive_finite, EmissionTexture, LightBounds, LightFlags, LightProfile,
+    LightSample, LightSource, ShadingCtx,
 };
 use crate::desc::LampSampling;
 use crate::geometry::Aabb;
@@ -120,8 +120,21 @@ impl TriangleLight {
         }
         SphericalTriangle::new(&self.p, p)
     }
+}
 
-    pub fn sample_li(&self, ctx: &ShadingCtx, u: Vec2) -> Option<LightSample> {
+/// Solid angle of the triangle with corners `v` relative to the viewer, whose lengths are
+/// `len` (Van Oosterom & Strackee 1983).
+pub(super) fn solid_angle(v: [Vec3; 3], len: [f32; 3]) -> f32 {
+    let ([a, b, c], [la, lb, lc]) = (v, len);
+    let num = a.dot(b.cross(c)).abs();
+    let den = la * lb * lc + a.dot(b) * lc + a.dot(c) * lb + b.dot(c) * la;
+    2.0 * num.atan2(den)
+}
+
+impl LightSource for TriangleLight {
+    const FLAGS: LightFlags = LightFlags::SURFACE;
+
+    fn sample_li(&self, ctx: &ShadingCtx, u: Vec2) -> Option<LightSample> {
         if let Some(sphere) = self.spherical(ctx.p) {
             let s = sphere.sample(ctx, u);
             // The point where the drawn direction meets the triangle's plane, h in front
@@ -157,7 +170,7 @@ impl TriangleLight {
         })
     }
 
-    pub fn pdf_li(&self, ctx: &ShadingCtx, wi: Vec3) -> f32 {
+    fn pdf_li(&self, ctx: &ShadingCtx, wi: Vec3) -> f32 {
         let cos_l = -wi.dot(self.n);
         if cos_l <= 0.0 || self.area == 0.0 {
             return 0.0;
@@ -180,7 +193,7 @@ impl TriangleLight {
 
     /// Radiance leaving the point with texture coordinates `uv` (the mesh's, interpolated
     /// as [`crate::scene::Mesh::uv_at`] does) towards `w`.
-    pub fn radiance(&self, n: Vec3, uv: Vec2, w: Vec3) -> Vec3 {
+    fn radiance(&self, n: Vec3, uv: Vec2, w: Vec3) -> Vec3 {
         if n.dot(w) > 0.0 {
             let tex = self
                 .texture
@@ -194,7 +207,7 @@ impl TriangleLight {
 
     /// Φ = A · L · ∫ shape · cos θ dω: π · A · L for a one-sided Lambertian emitter (L the
     /// texture's mean where there is one).
-    pub fn power(&self) -> f32 {
+    fn power(&self) -> f32 {
         self.projected_solid_angle * self.area * luminance(self.mean_le())
     }
 
@@ -203,7 +216,7 @@ impl TriangleLight {
     /// tan(Ω/2) = |a·(b×c)| / (abc + (a·b)c + (a·c)b + (b·c)a).
     /// Zero where the point lies behind the emitting side: the plane through the triangle
     /// separates the point from the whole emitting hemisphere, so nothing reaches it.
-    pub fn importance(&self, ctx: &ShadingCtx) -> f32 {
+    fn importance(&self, ctx: &ShadingCtx) -> f32 {
         if (ctx.p - self.p[0]).dot(self.n) <= 0.0 || self.area == 0.0 {
             return 0.0;
         }
@@ -215,25 +228,16 @@ impl TriangleLight {
 
     /// One-sided Lambertian emitter: normal cone of zero width, emission up to 90°;
     /// peak intensity L·A along the normal.
-    pub fn bounds(&self) -> LightBounds {
-        LightBounds {
+    fn bounds(&self) -> Option<LightBounds> {
+        Some(LightBounds {
             aabb: Aabb::from_points(&self.p),
             w: self.n,
             intensity: luminance(self.mean_le()) * self.area,
             cos_theta_o: 1.0,
             cos_theta_e: 0.0,
             two_sided: false,
-        }
+        })
     }
-}
-
-/// Solid angle of the triangle with corners `v` relative to the viewer, whose lengths are
-/// `len` (Van Oosterom & Strackee 1983).
-pub(super) fn solid_angle(v: [Vec3; 3], len: [f32; 3]) -> f32 {
-    let ([a, b, c], [la, lb, lc]) = (v, len);
-    let num = a.dot(b.cross(c)).abs();
-    let den = la * lb * lc + a.dot(b) * lc + a.dot(c) * lb + b.dot(c) * la;
-    2.0 * num.atan2(den)
 }
 
 #[cfg(test)]
