@@ -12,7 +12,7 @@ a few standard errors; the ggx variant shows the size of the old substitution.
 With `--mitsuba` it also renders the scene with Mitsuba 3 llvm_ad_rgb itself, as written
 and with ggx (`--passes` passes of 64 spp, seed 300 000), which measures the substitution
 without Candela: 0.9892, 0.9889, 0.9887 of the reference with ggx, 1.0021, 1.0014, 1.0009
-as written (bench/RESULTS.md).
+as written (bench/RESULTS.md, veach_beckmann).
 
 Needs bench/compare_mitsuba to have run on veach-bidir first (it writes
 bench/out/compare/veach-bidir_box.xml, a box-filter copy of the scene, and the 1024-spp
@@ -38,7 +38,8 @@ OUT = os.path.join(BENCH_DIR, "out", "compare")
 CANDELA = os.path.join(REPO, "target", "release", "candela")
 # Far from the reference's and the benchmark runs' seeds, so the noise is independent.
 MITSUBA_SEED = 300_000
-# The seeds of the 15-seed check in bench/RESULTS.md (the reference's are from 100 000).
+# The seeds of the 15-seed check in bench/RESULTS.md, veach_beckmann (the reference's are
+# from 100 000).
 DEFAULT_SEEDS = "2-4,10-21"
 
 

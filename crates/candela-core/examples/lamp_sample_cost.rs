@@ -7,8 +7,8 @@
 //! cargo run --release -p candela-core --example lamp_sample_cost
 //! ```
 //!
-//! Not part of CI; bench/RESULTS.md quotes it (stop 31). Wall time per call, so run it on
-//! a quiet machine.
+//! Not part of CI; bench/RESULTS.md quotes it (lamp_sample_cost). Wall time per call, so
+//! run it on a quiet machine.
 
 use std::hint::black_box;
 use std::time::Instant;

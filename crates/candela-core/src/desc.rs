@@ -607,7 +607,7 @@ pub enum LampSampling {
     /// Uniformly by area, everywhere: the default, the cheaper per sample, and the more
     /// efficient where most of the noise is indirect light (the Cornell box and a softbox
     /// scene measured 0.93× and 0.92× as efficient with `SolidAngle`: bench/RESULTS.md,
-    /// stop 31).
+    /// lamp_sampling).
     #[default]
     Area,
     /// Where a lamp is wider than its centre is far from the shading point, uniformly in
@@ -627,14 +627,15 @@ pub enum SamplerKind {
     Independent,
     /// Owen-scrambled Sobol' points, stratified within each pixel: `bench/sampler.sh`
     /// measured 1.56× lower relMSE than independent samples at 64 spp on the 512² Cornell
-    /// box and 1.68× on the depth-of-field scene for 5–10 % more time (bench/RESULTS.md).
+    /// box and 1.68× on the depth-of-field scene for 5–10 % more time (bench/JOURNAL.md,
+    /// "Samplers — `bench/sampler.sh`, noisy machine").
     Sobol,
     /// [`SamplerKind::Sobol`] except for the first bounce's BSDF direction, which comes
     /// from a correlated multi-jittered pattern of the planned spp
     /// ([`crate::sampler::SobolCmjSampler`]); the default, since it measured 1.135× lower
     /// relMSE than `Sobol` on the Cornell box at 64 spp (1.025× at 16), level or better
     /// on five other scenes, for ≈ 2.5 % more instructions in the render loop
-    /// (bench/RESULTS.md, stop 20).
+    /// (bench/RESULTS.md, sampler).
     #[default]
     SobolCmj,
 }
@@ -660,7 +661,7 @@ pub enum Isa {
 pub const DEFAULT_RIS_CANDIDATES: u32 = 2;
 
 /// Default of [`RenderSettings::rr_depth`]: Mitsuba's, and the most efficient start of
-/// the roulette measured on Candela's example scenes (bench/RESULTS.md, stop 17).
+/// the roulette measured on Candela's example scenes (bench/RESULTS.md, rr_depth).
 pub const DEFAULT_RR_DEPTH: u32 = 5;
 
 /// Render settings a scene carries; the command line may override them.

@@ -40,10 +40,11 @@ const MIN_COSINE_WEIGHT: f32 = 0.01;
 /// drawing in solid angle takes that variation out of the estimate; farther, it gains
 /// little for its cost (the spherical polygon's set-up and map take inverse trigonometry
 /// and chains of f64 square roots). `bench/lamp_sampling.sh` chose the bound
-/// (bench/RESULTS.md, stop 31): area / d² > 0.04 instead, which calls the Cornell box's
-/// small lamp near from everywhere, lost 45 % of the efficiency there for a 6 % lower
-/// variance. The test uses the centre's distance, so it costs a few instructions;
-/// `sample_li` and `pdf_li` make it from the same numbers and so always agree.
+/// (bench/JOURNAL.md, near lamps, stop 31): area / d² > 0.04 instead, which calls the
+/// Cornell box's small lamp near from everywhere, lost 45 % of the efficiency there for a
+/// 6 % lower variance. The test uses the centre's distance, so it costs a few
+/// instructions; `sample_li` and `pdf_li` make it from the same numbers and so always
+/// agree.
 #[inline(always)]
 pub(super) fn near(extent2: f32, d2: f32) -> bool {
     extent2 > d2

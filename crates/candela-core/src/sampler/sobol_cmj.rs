@@ -7,7 +7,7 @@
 //! m × q grid and in each of the n rows and columns, the offsets permuted alike) integrate
 //! better than a scrambled (0, k, 2)-net.
 //! For the pixel position and the lens (sharp edges), for light points and for deeper
-//! bounces Sobol' does as well or better (bench/RESULTS.md, "Sampler study (stop 19)" and
+//! bounces Sobol' does as well or better (bench/JOURNAL.md, "Sampler study (stop 19)" and
 //! "First-bounce pattern (stop 20)").
 //!
 //! The pattern: the m × q grid of [`super::CmjSampler`]'s (m the largest divisor of n not
