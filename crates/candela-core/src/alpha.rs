@@ -20,19 +20,11 @@
 
 use glam::Vec2;
 
+pub use crate::desc::AlphaMode;
 use crate::geometry::{Ray, TriangleHit};
 use crate::sampler::hash_uniform;
 use crate::scene::{Prim, Scene};
 use crate::texture::Texture;
-
-/// How a mesh's α hides it.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub enum AlphaMode {
-    /// Present where α ≥ `cutoff`.
-    Mask { cutoff: f32 },
-    /// Present with probability α.
-    Blend,
-}
 
 /// The coverage of a mesh's surface.
 #[derive(Clone, Debug)]

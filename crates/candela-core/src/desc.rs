@@ -250,10 +250,19 @@ pub enum MicrofacetDesc {
     Beckmann,
 }
 
+/// How a mesh's α hides it (see [`crate::alpha`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum AlphaMode {
+    /// Present where α ≥ `cutoff`.
+    Mask { cutoff: f32 },
+    /// Present with probability α.
+    Blend,
+}
+
 /// A surface's coverage α = `factor` × the texture's first channel (1 without one).
 #[derive(Clone, Debug)]
 pub struct AlphaDesc {
-    pub mode: crate::alpha::AlphaMode,
+    pub mode: AlphaMode,
     pub factor: f32,
     pub texture: Option<TextureDesc>,
 }
