@@ -204,7 +204,7 @@ impl RenderArgs {
     /// `--env` and `--env-strength`.
     fn apply_environment(&self, desc: &mut SceneDesc) -> Result<(), UserError> {
         if let Some(path) = &self.env {
-            let img = candela_scene::environment::load_linear_image(path)
+            let img = candela_scene::envmap::load_linear_image(path)
                 .map_err(|e| UserError(format!("{}: {e}", path.display())))?;
             desc.environment = Some(EnvironmentDesc {
                 map: EnvironmentMapDesc::Equirect(img),

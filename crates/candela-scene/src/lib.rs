@@ -1,7 +1,7 @@
 //! Candela's loaders: bytes in, [`SceneDesc`] out. All file I/O and format knowledge lives
 //! here; errors carry the file, line and column they refer to.
 //!
-//! One module per format: [`toml_scene`] reads Candela's own scene format (see
+//! One module per format: [`toml`] reads Candela's own scene format (see
 //! `docs/scene-format.md`), [`mitsuba`] a subset of Mitsuba 3's XML (see
 //! `docs/mitsuba.md`), [`gltf`] glTF 2.0, [`obj`] and [`ply`] read triangle meshes. A new scene format
 //! plugs in as a module and one arm of the match in [`load_scene`].
@@ -33,24 +33,16 @@ use std::sync::Arc;
 
 use candela_core::desc::{MeshDesc, SceneDesc, Span};
 
-pub mod environment;
+pub mod envmap;
 pub mod gltf;
 pub mod image_texture;
 pub mod limits;
 mod mesh_scene;
 pub mod obj;
 pub mod ply;
-pub mod serialized;
-mod toml_camera;
-mod toml_environment;
-mod toml_include;
-mod toml_light;
-mod toml_material;
-pub mod toml_scene;
-mod toml_shape;
-mod toml_values;
+pub mod toml;
 
-pub use toml_scene::parse_toml_scene;
+pub use crate::toml::parse_toml_scene;
 
 pub mod ies;
 pub mod mitsuba;
@@ -165,7 +157,7 @@ pub fn load_scene_with(path: &Path, options: &LoadOptions) -> Result<LoadedScene
         "toml" => {
             let text = std::fs::read_to_string(path)
                 .map_err(|e| LoadError::new(file_span(), format!("cannot read scene file: {e}")))?;
-            let (desc, warnings) = toml_scene::parse_toml_scene_with_warnings(&text, path)?;
+            let (desc, warnings) = crate::toml::parse_toml_scene_with_warnings(&text, path)?;
             Ok(LoadedScene { desc, warnings })
         }
         "xml" => mitsuba::load_mitsuba(path, options),
@@ -233,7 +225,7 @@ impl<'a> Source<'a> {
     }
 
     /// Converts a `toml` error, keeping its location.
-    pub fn toml_error(&self, e: &toml::de::Error) -> LoadError {
+    pub fn toml_error(&self, e: &::toml::de::Error) -> LoadError {
         let offset = e.span().map_or(0, |s| s.start);
         self.error(offset, e.message().trim().replace('\n', " "))
     }

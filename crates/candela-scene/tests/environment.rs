@@ -9,7 +9,7 @@ use candela_core::color::srgb_decode;
 use candela_core::desc::{EnvironmentMapDesc, ImageDesc};
 use candela_core::light::envmap::{cubemap, Cubemap, Equirect, Image};
 use candela_core::light::{EnvironmentLight, EnvironmentMap, LightSource, ShadingCtx};
-use candela_scene::environment::load_linear_image;
+use candela_scene::envmap::load_linear_image;
 use candela_scene::parse_toml_scene;
 use glam::{Mat3, Vec3};
 
@@ -84,9 +84,9 @@ fn humus_faces(dir: &Path) -> [ImageDesc; 6] {
         .collect();
     let refs: [&Path; 6] = std::array::from_fn(|i| paths[i].as_path());
     // The files are stored bottom row first (SOURCES.md): turn each face upright.
-    candela_scene::environment::load_cube_faces(&refs)
+    candela_scene::envmap::load_cube_faces(&refs)
         .unwrap()
-        .map(|f| candela_scene::environment::flip_vertical(&f))
+        .map(|f| candela_scene::envmap::flip_vertical(&f))
 }
 
 #[test]

@@ -6,7 +6,7 @@
 use std::io::Write;
 
 use candela_core::desc::{GeometryDesc, MeshDesc};
-use candela_scene::serialized::load_serialized;
+use candela_scene::mitsuba::serialized::load_serialized;
 use candela_scene::{load_scene_with, LoadOptions};
 use flate2::write::ZlibEncoder;
 use glam::{Vec2, Vec3};

@@ -14,7 +14,7 @@ use glam::{Affine2, Mat3, Mat4, Vec2, Vec3};
 use super::parse::Node;
 use super::sensor::{field_of_view, vertical_fov};
 use super::{describe, transform, Ctx};
-use crate::environment::load_linear_image;
+use crate::envmap::load_linear_image;
 use crate::LoadError;
 
 pub(crate) fn emitter(ctx: &mut Ctx, node: &Node) -> Result<(), LoadError> {

@@ -10,6 +10,7 @@ mod conductors;
 mod emitters;
 mod parse;
 mod sensor;
+pub mod serialized;
 mod shapes;
 mod spectra;
 mod textures;

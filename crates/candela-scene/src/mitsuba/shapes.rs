@@ -133,7 +133,7 @@ fn shape_desc(ctx: &mut Ctx, node: &Node) -> Result<Option<ShapeDesc>, LoadError
                 Some(m) => m.clone(),
                 None => {
                     let loaded = match node.kind() {
-                        "serialized" => crate::serialized::load_serialized(&key.0, index),
+                        "serialized" => crate::mitsuba::serialized::load_serialized(&key.0, index),
                         _ => crate::load_mesh(&key.0),
                     };
                     let mut mesh =

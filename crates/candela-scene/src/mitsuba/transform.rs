@@ -84,4 +84,4 @@ fn rotation(k: Vec3, angle: f32) -> Mat3 {
 /// Mitsuba's `Transform4f::look_at` is the TOML format's `look_at` step: the frame's +z
 /// looks at the target, +y is up and +x is up × forward (the image's left, as Mitsuba's
 /// cameras see it).
-pub(crate) use crate::toml_shape::look_at;
+pub(crate) use crate::toml::shape::look_at;

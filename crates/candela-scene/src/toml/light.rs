@@ -16,8 +16,8 @@ use serde::Deserialize;
 use toml::Spanned;
 
 use crate::image_texture::{load_image, Encoding};
-use crate::toml_scene::{deserialize, item_type, Item};
-use crate::toml_values::{Num, Splat3, V3};
+use crate::toml::values::{Num, Splat3, V3};
+use crate::toml::{deserialize, item_type, Item};
 use crate::{LoadError, Source};
 
 #[derive(Deserialize, Clone, Copy, PartialEq, Eq)]

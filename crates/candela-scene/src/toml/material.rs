@@ -13,8 +13,8 @@ use serde::{Deserialize, Deserializer};
 use toml::Spanned;
 
 use crate::image_texture::{load_image, Encoding};
-use crate::toml_scene::{deserialize, Item};
-use crate::toml_values::{Num, Splat3, V2};
+use crate::toml::values::{Num, Splat3, V2};
+use crate::toml::{deserialize, Item};
 use crate::{LoadError, Source};
 
 /// The material types, for `type = "..."`.

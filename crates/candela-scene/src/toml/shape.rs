@@ -11,9 +11,9 @@ use serde::de::IgnoredAny;
 use serde::Deserialize;
 use toml::Spanned;
 
-use crate::toml_material::{texture, Slot, TexValue};
-use crate::toml_scene::{deserialize, item_type, Item};
-use crate::toml_values::{Num, NumArray, Splat3, V2, V3};
+use crate::toml::material::{texture, Slot, TexValue};
+use crate::toml::values::{Num, NumArray, Splat3, V2, V3};
+use crate::toml::{deserialize, item_type, Item};
 use crate::{load_mesh, LoadError, Source};
 
 /// One step of a `transform` list: a one-key inline table such as `{ translate = [...] }`.
@@ -251,7 +251,7 @@ pub(crate) fn parse_shape(
             return Err(src.error(file.span().start, "`ies` is not supported on spheres"))
         }
         Some(file) => Some((
-            crate::toml_light::load_ies_table(src, base, file)?,
+            crate::toml::light::load_ies_table(src, base, file)?,
             src.span(file.span().start),
         )),
     };

@@ -11,10 +11,10 @@ use serde::de::{self, Deserializer, MapAccess, Visitor};
 use serde::Deserialize;
 use toml::Spanned;
 
-use crate::environment::{flip_vertical, load_cube_faces, load_linear_image, split_cross};
-use crate::toml_scene::{deserialize, Item};
-use crate::toml_shape::{compose, TransformOp};
-use crate::toml_values::{Num, Splat3};
+use crate::envmap::{flip_vertical, load_cube_faces, load_linear_image, split_cross};
+use crate::toml::shape::{compose, TransformOp};
+use crate::toml::values::{Num, Splat3};
+use crate::toml::{deserialize, Item};
 use crate::{LoadError, Source};
 
 /// `cubemap = "cross.hdr"` or `cubemap = { px = …, nx = …, py = …, ny = …, pz = …, nz = … }`.

@@ -20,8 +20,8 @@ use serde::Deserialize;
 use toml::Spanned;
 
 use crate::gltf::parse_gltf_scene;
-use crate::toml_scene::{deserialize, Item};
-use crate::toml_shape::{check_transform_steps, compose, TransformOp};
+use crate::toml::shape::{check_transform_steps, compose, TransformOp};
+use crate::toml::{deserialize, Item};
 use crate::{LoadError, LoadOptions, Source};
 
 #[derive(Deserialize)]

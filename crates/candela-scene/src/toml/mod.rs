@@ -8,6 +8,14 @@
 //! offending key or value. Items that take a `type` are dispatched on it first, so a key
 //! that belongs to another type is reported as unknown.
 
+mod camera;
+mod environment;
+mod include;
+mod light;
+mod material;
+pub(crate) mod shape;
+mod values;
+
 use std::path::Path;
 
 use candela_core::desc::{
@@ -19,13 +27,13 @@ use serde::Deserialize;
 use toml::de::{DeTable, DeValue, ValueDeserializer};
 use toml::Spanned;
 
-use crate::toml_camera::parse_camera;
-use crate::toml_environment::parse_environment;
-use crate::toml_include::parse_include;
-use crate::toml_light::parse_light;
-use crate::toml_material::{parse_material, MATERIAL_TYPES};
-use crate::toml_shape::parse_shape;
 use crate::{LoadError, Source};
+use camera::parse_camera;
+use environment::parse_environment;
+use include::parse_include;
+use light::parse_light;
+use material::{parse_material, MATERIAL_TYPES};
+use shape::parse_shape;
 
 /// One item of the parsed tree: a value and its byte range in the text.
 pub(crate) type Item<'i> = Spanned<DeValue<'i>>;

@@ -9,8 +9,8 @@ use candela_core::desc::{ApertureDesc, ApertureSizeDesc, CameraDesc, FocusDesc, 
 use serde::Deserialize;
 use toml::Spanned;
 
-use crate::toml_scene::{deserialize, item_type, Item};
-use crate::toml_values::{Num, V2, V3};
+use crate::toml::values::{Num, V2, V3};
+use crate::toml::{deserialize, item_type, Item};
 use crate::{LoadError, Source};
 
 #[derive(Deserialize)]
