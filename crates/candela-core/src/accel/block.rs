@@ -486,6 +486,56 @@ mod tests {
         hit.map(|h| (h.id, [h.hit.t, h.hit.b1, h.hit.b2].map(f32::to_bits)))
     }
 
+    /// The nearest hit of a plain loop over `intersect_sphere` and
+    /// `WatertightRay::intersect` on `prims` (filtered triangles accepted where their lane
+    /// is even), as (lane, bits of t, b1, b2); asserts that the scalar kernel finds it and
+    /// that every kernel the CPU has finds the scalar kernel's bits (any-hit: whether).
+    fn check_every_kernel(
+        trial: u32,
+        prims: &[([Vec3; 3], u32)],
+        block: &Block,
+        ray: &Ray,
+        t_max: f32,
+    ) -> Option<(u32, [u32; 3])> {
+        let accept_even = |id: u32, _: &TriangleHit| id.is_multiple_of(2);
+        let count = prims.len() as u32;
+        let mut reference = None;
+        let mut best = t_max;
+        for (lane, (v, id)) in prims.iter().enumerate() {
+            let hit = if id & SPHERE != 0 {
+                intersect_sphere(ray, v[0], v[1].x, best).map(|t| TriangleHit {
+                    t,
+                    b1: 0.0,
+                    b2: 0.0,
+                })
+            } else {
+                WatertightRay::new(ray)
+                    .intersect(v[0], v[1], v[2], best)
+                    .filter(|h| id & FILTERED == 0 || accept_even(lane as u32, h))
+            };
+            if let Some(h) = hit {
+                best = h.t;
+                reference = Some((lane as u32, [h.t, h.b1, h.b2].map(f32::to_bits)));
+            }
+        }
+        let scalar = trace::<false>(Simd::Scalar, block, ray, count, t_max, &accept_even);
+        assert_eq!(
+            scalar, reference,
+            "trial {trial}: scalar kernel vs a plain loop"
+        );
+        for simd in Simd::available() {
+            let nearest = trace::<false>(simd, block, ray, count, t_max, &accept_even);
+            assert_eq!(nearest, scalar, "trial {trial}: {simd:?}, {count} lanes");
+            let any = trace::<true>(simd, block, ray, count, t_max, &accept_even);
+            assert_eq!(
+                any.is_some(),
+                scalar.is_some(),
+                "trial {trial}: {simd:?} any-hit"
+            );
+        }
+        scalar
+    }
+
     /// Every fill from one lane to eight, plain blocks and blocks mixing spheres and
     /// filtered triangles in: each kernel the CPU has returns the scalar kernel's lane,
     /// distance and barycentrics bit for bit, and that is the nearest hit of a plain loop
@@ -497,7 +547,6 @@ mod tests {
         let mut rng = Pcg32::new(8, 8);
         let simds = Simd::available();
         let (mut hits, mut vertex_hits, mut mixed) = (0, 0, 0);
-        let accept_even = |id: u32, _: &TriangleHit| id.is_multiple_of(2);
         for trial in 0..40000u32 {
             let count = 1 + trial % 8;
             let kind = |lane: u32| (trial / 8 + lane) % 11;
@@ -555,40 +604,7 @@ mod tests {
                 f32::INFINITY
             };
 
-            let mut reference = None;
-            let mut best = t_max;
-            for (lane, (v, id)) in prims.iter().enumerate() {
-                let hit = if id & SPHERE != 0 {
-                    intersect_sphere(&ray, v[0], v[1].x, best).map(|t| TriangleHit {
-                        t,
-                        b1: 0.0,
-                        b2: 0.0,
-                    })
-                } else {
-                    WatertightRay::new(&ray)
-                        .intersect(v[0], v[1], v[2], best)
-                        .filter(|h| id & FILTERED == 0 || accept_even(lane as u32, h))
-                };
-                if let Some(h) = hit {
-                    best = h.t;
-                    reference = Some((lane as u32, [h.t, h.b1, h.b2].map(f32::to_bits)));
-                }
-            }
-            let scalar = trace::<false>(Simd::Scalar, &block, &ray, count, t_max, &accept_even);
-            assert_eq!(
-                scalar, reference,
-                "trial {trial}: scalar kernel vs a plain loop"
-            );
-            for &simd in &simds {
-                let nearest = trace::<false>(simd, &block, &ray, count, t_max, &accept_even);
-                assert_eq!(nearest, scalar, "trial {trial}: {simd:?}, {count} lanes");
-                let any = trace::<true>(simd, &block, &ray, count, t_max, &accept_even);
-                assert_eq!(
-                    any.is_some(),
-                    scalar.is_some(),
-                    "trial {trial}: {simd:?} any-hit"
-                );
-            }
+            let scalar = check_every_kernel(trial, &prims, &block, &ray, t_max);
             hits += scalar.is_some() as u32;
             vertex_hits += (at_vertex && scalar.is_some()) as u32;
         }
@@ -653,41 +669,7 @@ mod tests {
             } else {
                 f32::INFINITY
             };
-            let accept_even = |id: u32, _: &TriangleHit| id.is_multiple_of(2);
-            let mut reference = None;
-            let mut best = t_max;
-            for (lane, (v, id)) in prims.iter().enumerate() {
-                let hit = if id & SPHERE != 0 {
-                    intersect_sphere(&ray, v[0], v[1].x, best).map(|t| TriangleHit {
-                        t,
-                        b1: 0.0,
-                        b2: 0.0,
-                    })
-                } else {
-                    WatertightRay::new(&ray)
-                        .intersect(v[0], v[1], v[2], best)
-                        .filter(|h| id & FILTERED == 0 || accept_even(lane as u32, h))
-                };
-                if let Some(h) = hit {
-                    best = h.t;
-                    reference = Some((lane as u32, [h.t, h.b1, h.b2].map(f32::to_bits)));
-                }
-            }
-            let scalar = trace::<false>(Simd::Scalar, &block, &ray, count, t_max, &accept_even);
-            assert_eq!(
-                scalar, reference,
-                "trial {trial}: scalar kernel vs a plain loop"
-            );
-            for &simd in &simds {
-                let nearest = trace::<false>(simd, &block, &ray, count, t_max, &accept_even);
-                assert_eq!(nearest, scalar, "trial {trial}: {simd:?}, {count} lanes");
-                let any = trace::<true>(simd, &block, &ray, count, t_max, &accept_even);
-                assert_eq!(
-                    any.is_some(),
-                    scalar.is_some(),
-                    "trial {trial}: {simd:?} any-hit"
-                );
-            }
+            let scalar = check_every_kernel(trial, &prims, &block, &ray, t_max);
             if let Some((lane, _)) = scalar {
                 hits += 1;
                 if prims[lane as usize].1 & SPHERE != 0 {
