@@ -7,15 +7,18 @@
 //! the same order (Rust never fuses a multiply and an add on its own), so each lane's
 //! distance and barycentrics are the same bits as the scalar test's. Lanes where an edge
 //! function is exactly zero take the scalar test, which retries those in double precision
-//! as the paper does. A sphere or filtered-triangle lane takes the scalar test inside the
-//! vector path (the block's triangles are still tested together), and everything under
-//! [`Simd::Scalar`] goes lane by lane: the reference the tests compare the vector paths
-//! against.
+//! as the paper does. Sphere lanes take the vector sphere test ([`super::sphere`]) in the
+//! same pass, with the same bits as the scalar one; a filtered-triangle lane takes the
+//! scalar test inside the vector path (the block's triangles are still tested together),
+//! and everything under [`Simd::Scalar`] goes lane by lane: the reference the tests
+//! compare the vector paths against.
 
 use glam::Vec3;
 
 #[cfg(target_arch = "x86_64")]
 use super::lanes::Wide;
+#[cfg(target_arch = "x86_64")]
+use super::sphere;
 #[cfg(doc)]
 use crate::bvh::Simd;
 use crate::geometry::{intersect_sphere, Ray, TriangleHit, WatertightRay};
@@ -82,7 +85,12 @@ impl Block {
         Vec3::new(v[0][lane], v[1][lane], v[2][lane])
     }
 
-    /// Whether every lane is an unfiltered triangle (the vector path).
+    /// Whether every lane is an unfiltered triangle.
+    pub fn is_plain(&self) -> bool {
+        self.id.iter().all(|&id| id & (SPHERE | FILTERED) == 0)
+    }
+
+    /// [`Block::is_plain`] as the vector kernels check it.
     #[inline(always)]
     fn plain<const KERNEL: u8>(&self) -> bool {
         #[cfg(target_arch = "x86_64")]
@@ -104,9 +112,10 @@ impl Block {
     /// `KERNEL` chooses the vector test for plain blocks ([`SSE`], [`AVX2`]: x86-64
     /// only, and the CPU must have it). With `ANY`, the first hit found is returned, not
     /// the nearest, and from the vector test without barycentrics (a shadow ray needs
-    /// only whether).
+    /// only whether). `PLAIN` vouches that the block holds only unfiltered triangles
+    /// (the whole structure does), which skips the vector kernels' check.
     #[inline(always)]
-    pub fn intersect<const KERNEL: u8, const ANY: bool>(
+    pub fn intersect<const KERNEL: u8, const ANY: bool, const PLAIN: bool>(
         &self,
         ray: &Ray,
         wray: &WatertightRay,
@@ -116,17 +125,33 @@ impl Block {
     ) -> Option<LaneHit> {
         #[cfg(target_arch = "x86_64")]
         if KERNEL != SCALAR {
-            // A sphere or filtered lane takes the scalar test within the vector one, so a
-            // mixed block still tests its plain triangles together (a sphere among seven
-            // triangles made the whole block scalar: +20 % time on a Cornell box with one).
-            let special = if self.plain::<KERNEL>() {
-                0
-            } else {
-                self.special_lanes(count)
-            };
+            // A filtered lane takes the scalar test within the vector one, so a mixed
+            // block still tests its plain triangles together (a sphere among seven
+            // triangles made the whole block scalar: +20 % time on a Cornell box with one);
+            // sphere lanes take the vector sphere test alongside.
+            // With `PLAIN`, a copy without the sphere test's branches (they cost the
+            // Cornell box, which has no sphere, +3 % instructions a path: callgrind).
+            // Otherwise one copy for every block: a second one for plain blocks, inlined
+            // too, cost sphere scenes 1–3 % more than it saved.
             // SAFETY: SSE is part of the x86-64 baseline, and the caller vouches for AVX2.
             return unsafe {
-                self.intersect_lanes::<KERNEL, ANY>(ray, wray, count, t_max, special, filter)
+                if PLAIN {
+                    self.intersect_lanes::<KERNEL, ANY, false>(
+                        ray, wray, count, t_max, 0, 0, filter,
+                    )
+                } else {
+                    let (spheres, filtered) = if self.plain::<KERNEL>() {
+                        (0, 0)
+                    } else {
+                        (
+                            self.lanes_with(SPHERE, count),
+                            self.lanes_with(FILTERED, count),
+                        )
+                    };
+                    self.intersect_lanes::<KERNEL, ANY, true>(
+                        ray, wray, count, t_max, spheres, filtered, filter,
+                    )
+                }
             };
         }
         let mut best = None;
@@ -146,11 +171,11 @@ impl Block {
         best
     }
 
-    /// Bits of the first `count` lanes that hold a sphere or a filtered triangle.
+    /// Bits of the first `count` lanes whose id has the flag `flag`.
     #[cfg(target_arch = "x86_64")]
-    fn special_lanes(&self, count: u32) -> u32 {
+    fn lanes_with(&self, flag: u32, count: u32) -> u32 {
         (0..count as usize)
-            .filter(|&lane| self.id[lane] & (SPHERE | FILTERED) != 0)
+            .filter(|&lane| self.id[lane] & flag != 0)
             .fold(0, |bits, lane| bits | 1 << lane)
     }
 
@@ -182,19 +207,22 @@ impl Block {
     }
 
     /// The vector test of a block: the nearest hit, the lowest lane among equals (as a
-    /// sequential loop that narrows `t_max` would find). The `special` lanes (spheres,
-    /// filtered triangles) take [`Block::lane_test`] in that loop instead.
+    /// sequential loop that narrows `t_max` would find). The `spheres` lanes take the
+    /// vector sphere test; the `special` lanes (filtered triangles) take
+    /// [`Block::lane_test`] in that loop instead.
     ///
     /// # Safety
     /// The CPU must support `KERNEL`.
     #[cfg(target_arch = "x86_64")]
     #[inline(always)]
-    unsafe fn intersect_lanes<const KERNEL: u8, const ANY: bool>(
+    #[allow(clippy::too_many_arguments)]
+    unsafe fn intersect_lanes<const KERNEL: u8, const ANY: bool, const MIXED: bool>(
         &self,
         ray: &Ray,
         w: &WatertightRay,
         count: u32,
         t_max: f32,
+        spheres: u32,
         special: u32,
         filter: &impl Fn(u32, &TriangleHit) -> bool,
     ) -> Option<LaneHit> {
@@ -204,14 +232,23 @@ impl Block {
         let mut out = MaybeUninit::<Lanes>::uninit();
         let out = out.as_mut_ptr();
         let (hit, edge) = if KERNEL == AVX2 {
-            self.test_lanes::<__m256, ANY>(w, 0, used, t_max, out)
+            self.test_lanes::<__m256, ANY, MIXED>(ray, w, 0, used, spheres, t_max, out)
         } else {
-            let (h0, e0) = self.test_lanes::<__m128, ANY>(w, 0, used & 15, t_max, out);
+            let (h0, e0) =
+                self.test_lanes::<__m128, ANY, MIXED>(ray, w, 0, used & 15, spheres, t_max, out);
             // (A special lane's bit says nothing: only a triangle's hit ends a shadow ray.)
             if count <= 4 || (ANY && h0 & !special != 0) {
                 (h0, e0)
             } else {
-                let (h1, e1) = self.test_lanes::<__m128, ANY>(w, 4, used >> 4, t_max, out);
+                let (h1, e1) = self.test_lanes::<__m128, ANY, MIXED>(
+                    ray,
+                    w,
+                    4,
+                    used >> 4,
+                    spheres,
+                    t_max,
+                    out,
+                );
                 (h0 | h1, e0 | e1)
             }
         };
@@ -281,24 +318,54 @@ impl Block {
     }
 
     /// [`WatertightRay::intersect`] on the `V::LANES` lanes from `first` on (`used`: the
-    /// filled ones, bit 0 = lane `first`): which are hit without an exactly-zero edge
-    /// function, and which have one (for the scalar retry), as bits of the block's
-    /// lanes. Where some lane is either, the distances (and without `ANY` the
-    /// barycentrics) go to `out`.
+    /// filled ones, bit 0 = lane `first`), and [`intersect_sphere`] on those of them that
+    /// `spheres` names (bits of the block's lanes): which are hit without an
+    /// exactly-zero edge function, and which triangles have one (for the scalar retry),
+    /// as bits of the block's lanes. Where some lane is either, the distances (and
+    /// without `ANY` the barycentrics, zero for a sphere) go to `out`.
     ///
     /// # Safety
     /// The CPU must support `V`; `first + V::LANES <= LANES`.
     #[cfg(target_arch = "x86_64")]
     #[inline(always)]
-    unsafe fn test_lanes<V: Wide, const ANY: bool>(
+    #[allow(clippy::too_many_arguments)]
+    unsafe fn test_lanes<V: Wide, const ANY: bool, const MIXED: bool>(
         &self,
+        ray: &Ray,
         w: &WatertightRay,
         first: usize,
         used: u32,
+        spheres: u32,
         t_max: f32,
         out: *mut Lanes,
     ) -> (u32, u32) {
         debug_assert!(first + V::LANES <= LANES);
+        let row = |r: *mut [f32; LANES]| (r as *mut f32).add(first);
+        let zero = V::splat(0.0);
+        // The sphere lanes of this register, tested together; a block of triangles only
+        // pays this branch.
+        let sph = if MIXED { (spheres >> first) & used } else { 0 };
+        let (sphere_hit, sphere_t) = if sph != 0 {
+            let at = |vertex: usize, axis: usize| self.v[vertex][axis].as_ptr().add(first);
+            let (hit, t) =
+                sphere::intersect_spheres::<V>(ray, [0, 1, 2].map(|k| at(0, k)), at(1, 0), t_max);
+            (hit.and(V::from_bits(sph)), t)
+        } else {
+            (zero, zero)
+        };
+        let sphere_bits = sphere_hit.bits();
+        let tris = used & !sph;
+        if MIXED && tris == 0 {
+            if sphere_bits == 0 {
+                return (0, 0);
+            }
+            sphere_t.store(row(std::ptr::addr_of_mut!((*out).t)));
+            if !ANY {
+                zero.store(row(std::ptr::addr_of_mut!((*out).b1)));
+                zero.store(row(std::ptr::addr_of_mut!((*out).b2)));
+            }
+            return (sphere_bits << first, 0);
+        }
         let (kx, ky, kz) = (w.kx, w.ky, w.kz);
         let (ox, oy, oz) = (V::splat(w.o_k.x), V::splat(w.o_k.y), V::splat(w.o_k.z));
         let (sx, sy, sz) = (
@@ -324,10 +391,11 @@ impl Block {
         let u = cx.mul(by).sub(cy.mul(bx));
         let v = ax.mul(cy).sub(ay.mul(cx));
         let ww = bx.mul(ay).sub(by.mul(ax));
-        let zero = V::splat(0.0);
         // Unused lanes need no mask here: their NaN vertices give NaN edge functions and
-        // distances, which are neither zero nor in range.
+        // distances, which are neither zero nor in range. Sphere lanes' are not about a
+        // triangle.
         let on_edge = u.eq(zero).or(v.eq(zero)).or(ww.eq(zero)).bits();
+        let on_edge = if MIXED { on_edge & !sph } else { on_edge };
         // Some edge function negative and some positive: the scalar test's six
         // comparisons as the sign of the least and the greatest. (They differ only where
         // one is NaN, and there `det` and `t` are NaN too, which no lane passes.)
@@ -342,7 +410,7 @@ impl Block {
         let bad_neg = det.lt(zero).and(t_scaled.ge(zero).or(t_scaled.lt(limit)));
         let bad_pos = det.gt(zero).and(t_scaled.le(zero).or(t_scaled.gt(limit)));
         let rejected = mixed_signs.or(det.eq(zero)).or(bad_neg.or(bad_pos));
-        if !ANY && !rejected.bits() & used | on_edge == 0 {
+        if !ANY && !rejected.bits() & tris | on_edge | sphere_bits == 0 {
             // Every lane is rejected before the division, as in the scalar test (for a
             // shadow ray, whose blocks are hit more often, the check costs more than it
             // saves: callgrind, any-hit instructions per ray on the room 468 -> 480).
@@ -352,15 +420,24 @@ impl Block {
         let t = t_scaled.mul(inv_det);
         let in_range = t.gt(zero).and(t.lt(t_max_v));
         let hit = rejected.andnot(in_range).bits() & !on_edge;
+        let hit = if MIXED { hit & !sph | sphere_bits } else { hit };
         if hit | on_edge == 0 {
             return (0, 0);
         }
-        let row = |r: *mut [f32; LANES]| (r as *mut f32).add(first);
+        let (t, b1, b2) = (t, v.mul(inv_det), ww.mul(inv_det));
+        let (t, b1, b2) = if MIXED {
+            (
+                sphere_hit.select(sphere_t, t),
+                sphere_hit.andnot(b1),
+                sphere_hit.andnot(b2),
+            )
+        } else {
+            (t, b1, b2)
+        };
         t.store(row(std::ptr::addr_of_mut!((*out).t)));
         if !ANY {
-            v.mul(inv_det).store(row(std::ptr::addr_of_mut!((*out).b1)));
-            ww.mul(inv_det)
-                .store(row(std::ptr::addr_of_mut!((*out).b2)));
+            b1.store(row(std::ptr::addr_of_mut!((*out).b1)));
+            b2.store(row(std::ptr::addr_of_mut!((*out).b2)));
         }
         (hit << first, on_edge << first)
     }
@@ -394,12 +471,12 @@ mod tests {
             t_max: f32,
             filter: &impl Fn(u32, &TriangleHit) -> bool,
         ) -> Option<LaneHit> {
-            block.intersect::<AVX2, ANY>(ray, &WatertightRay::new(ray), count, t_max, filter)
+            block.intersect::<AVX2, ANY, false>(ray, &WatertightRay::new(ray), count, t_max, filter)
         }
         let w = WatertightRay::new(ray);
         let hit = match simd {
-            Simd::Scalar => block.intersect::<SCALAR, ANY>(ray, &w, count, t_max, filter),
-            Simd::Sse => block.intersect::<SSE, ANY>(ray, &w, count, t_max, filter),
+            Simd::Scalar => block.intersect::<SCALAR, ANY, false>(ray, &w, count, t_max, filter),
+            Simd::Sse => block.intersect::<SSE, ANY, false>(ray, &w, count, t_max, filter),
             // SAFETY: the caller passes only kernels from `Simd::available`.
             #[cfg(target_arch = "x86_64")]
             Simd::Avx2 => unsafe { avx2::<ANY>(block, ray, count, t_max, filter) },
@@ -407,6 +484,56 @@ mod tests {
             Simd::Avx2 => unreachable!(),
         };
         hit.map(|h| (h.id, [h.hit.t, h.hit.b1, h.hit.b2].map(f32::to_bits)))
+    }
+
+    /// The nearest hit of a plain loop over `intersect_sphere` and
+    /// `WatertightRay::intersect` on `prims` (filtered triangles accepted where their lane
+    /// is even), as (lane, bits of t, b1, b2); asserts that the scalar kernel finds it and
+    /// that every kernel the CPU has finds the scalar kernel's bits (any-hit: whether).
+    fn check_every_kernel(
+        trial: u32,
+        prims: &[([Vec3; 3], u32)],
+        block: &Block,
+        ray: &Ray,
+        t_max: f32,
+    ) -> Option<(u32, [u32; 3])> {
+        let accept_even = |id: u32, _: &TriangleHit| id.is_multiple_of(2);
+        let count = prims.len() as u32;
+        let mut reference = None;
+        let mut best = t_max;
+        for (lane, (v, id)) in prims.iter().enumerate() {
+            let hit = if id & SPHERE != 0 {
+                intersect_sphere(ray, v[0], v[1].x, best).map(|t| TriangleHit {
+                    t,
+                    b1: 0.0,
+                    b2: 0.0,
+                })
+            } else {
+                WatertightRay::new(ray)
+                    .intersect(v[0], v[1], v[2], best)
+                    .filter(|h| id & FILTERED == 0 || accept_even(lane as u32, h))
+            };
+            if let Some(h) = hit {
+                best = h.t;
+                reference = Some((lane as u32, [h.t, h.b1, h.b2].map(f32::to_bits)));
+            }
+        }
+        let scalar = trace::<false>(Simd::Scalar, block, ray, count, t_max, &accept_even);
+        assert_eq!(
+            scalar, reference,
+            "trial {trial}: scalar kernel vs a plain loop"
+        );
+        for simd in Simd::available() {
+            let nearest = trace::<false>(simd, block, ray, count, t_max, &accept_even);
+            assert_eq!(nearest, scalar, "trial {trial}: {simd:?}, {count} lanes");
+            let any = trace::<true>(simd, block, ray, count, t_max, &accept_even);
+            assert_eq!(
+                any.is_some(),
+                scalar.is_some(),
+                "trial {trial}: {simd:?} any-hit"
+            );
+        }
+        scalar
     }
 
     /// Every fill from one lane to eight, plain blocks and blocks mixing spheres and
@@ -420,7 +547,6 @@ mod tests {
         let mut rng = Pcg32::new(8, 8);
         let simds = Simd::available();
         let (mut hits, mut vertex_hits, mut mixed) = (0, 0, 0);
-        let accept_even = |id: u32, _: &TriangleHit| id.is_multiple_of(2);
         for trial in 0..40000u32 {
             let count = 1 + trial % 8;
             let kind = |lane: u32| (trial / 8 + lane) % 11;
@@ -478,40 +604,7 @@ mod tests {
                 f32::INFINITY
             };
 
-            let mut reference = None;
-            let mut best = t_max;
-            for (lane, (v, id)) in prims.iter().enumerate() {
-                let hit = if id & SPHERE != 0 {
-                    intersect_sphere(&ray, v[0], v[1].x, best).map(|t| TriangleHit {
-                        t,
-                        b1: 0.0,
-                        b2: 0.0,
-                    })
-                } else {
-                    WatertightRay::new(&ray)
-                        .intersect(v[0], v[1], v[2], best)
-                        .filter(|h| id & FILTERED == 0 || accept_even(lane as u32, h))
-                };
-                if let Some(h) = hit {
-                    best = h.t;
-                    reference = Some((lane as u32, [h.t, h.b1, h.b2].map(f32::to_bits)));
-                }
-            }
-            let scalar = trace::<false>(Simd::Scalar, &block, &ray, count, t_max, &accept_even);
-            assert_eq!(
-                scalar, reference,
-                "trial {trial}: scalar kernel vs a plain loop"
-            );
-            for &simd in &simds {
-                let nearest = trace::<false>(simd, &block, &ray, count, t_max, &accept_even);
-                assert_eq!(nearest, scalar, "trial {trial}: {simd:?}, {count} lanes");
-                let any = trace::<true>(simd, &block, &ray, count, t_max, &accept_even);
-                assert_eq!(
-                    any.is_some(),
-                    scalar.is_some(),
-                    "trial {trial}: {simd:?} any-hit"
-                );
-            }
+            let scalar = check_every_kernel(trial, &prims, &block, &ray, t_max);
             hits += scalar.is_some() as u32;
             vertex_hits += (at_vertex && scalar.is_some()) as u32;
         }
@@ -523,5 +616,75 @@ mod tests {
         eprintln!(
             "kernels {simds:?}: {hits} hits, {vertex_hits} at vertices, {mixed} mixed blocks"
         );
+    }
+
+    /// Blocks mostly of spheres (some overlapping, some rays starting inside one, some
+    /// grazing): each kernel the CPU has returns the scalar kernel's lane and distance bit
+    /// for bit, and that is the nearest hit of a plain loop over `intersect_sphere` and
+    /// `WatertightRay::intersect`. The vector sphere test must reproduce the scalar one's
+    /// rounding in every lane, so the comparison is exact.
+    #[test]
+    fn sphere_lanes_give_the_scalar_bits() {
+        let mut rng = Pcg32::new(35, 1);
+        let simds = Simd::available();
+        let (mut hits, mut sphere_hits, mut inside) = (0, 0, 0);
+        for trial in 0..40000u32 {
+            let count = 1 + trial % 8;
+            let mut prims = Vec::new();
+            for lane in 0..count {
+                let kind = rng.next_u32() % 8;
+                let v = [0; 3].map(|_| v3(&mut rng));
+                let prim = if kind < 6 {
+                    let radius = 0.02 + 0.3 * rng.uniform_f32();
+                    (
+                        [v[0], Vec3::new(radius, 0.0, 0.0), Vec3::ZERO],
+                        lane | SPHERE,
+                    )
+                } else if kind == 6 {
+                    (v, lane | FILTERED)
+                } else {
+                    (v, lane)
+                };
+                prims.push(prim);
+            }
+            let block = Block::new(&prims);
+            let (target, id) = prims[rng.next_u32() as usize % count as usize];
+            let centre = if id & SPHERE != 0 {
+                target[0]
+            } else {
+                (target[0] + target[1] + target[2]) / 3.0
+            };
+            let radius = if id & SPHERE != 0 { target[1].x } else { 0.1 };
+            // A quarter start inside the aimed-at sphere (the far root); the others aim
+            // within 1.2 radii of its centre, so some graze or miss.
+            let o = if trial % 4 == 0 {
+                centre + (v3(&mut rng) - 0.5) * radius
+            } else {
+                v3(&mut rng) * 4.0 - 1.5
+            };
+            let aim = centre + (v3(&mut rng) * 2.0 - 1.0) * 1.2 * radius;
+            let ray = Ray::new(o, (aim - o).normalize_or(Vec3::Y));
+            let t_max = if trial % 5 == 0 {
+                3.0 * rng.uniform_f32()
+            } else {
+                f32::INFINITY
+            };
+            let scalar = check_every_kernel(trial, &prims, &block, &ray, t_max);
+            if let Some((lane, _)) = scalar {
+                hits += 1;
+                if prims[lane as usize].1 & SPHERE != 0 {
+                    sphere_hits += 1;
+                    inside += (trial % 4 == 0) as u32;
+                }
+            }
+        }
+        // Thresholds: three quarters of the lanes are spheres and most rays aim within
+        // their radius, a quarter from inside (which always hit unless t_max cuts).
+        assert!(
+            sphere_hits > 15000,
+            "only {sphere_hits} sphere hits of {hits}"
+        );
+        assert!(inside > 4000, "only {inside} hits from inside a sphere");
+        eprintln!("kernels {simds:?}: {hits} hits, {sphere_hits} on spheres, {inside} from inside");
     }
 }

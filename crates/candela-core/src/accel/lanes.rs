@@ -1,4 +1,4 @@
-//! The few vector operations the block's watertight test needs, over a register of 4
+//! The few vector operations the block's watertight and sphere tests need, over a register of 4
 //! (SSE) or 8 (AVX2) floats, so that one generic kernel serves both widths and each
 //! lane performs the very operations of the scalar test: plain IEEE add, subtract,
 //! multiply and divide (never fused) and ordered comparisons.
@@ -21,6 +21,8 @@ pub trait Wide: Copy {
     unsafe fn sub(self, o: Self) -> Self;
     unsafe fn mul(self, o: Self) -> Self;
     unsafe fn div(self, o: Self) -> Self;
+    /// The correctly rounded square root, as `f32::sqrt`.
+    unsafe fn sqrt(self) -> Self;
     /// `minps`/`maxps`: `o` where either is NaN.
     unsafe fn min(self, o: Self) -> Self;
     unsafe fn max(self, o: Self) -> Self;
@@ -35,6 +37,13 @@ pub trait Wide: Copy {
     unsafe fn ge(self, o: Self) -> Self;
     /// Bit `i` set where lane `i` is true.
     unsafe fn bits(self) -> u32;
+    /// All-ones lanes where bit `i` of `bits` is set: the inverse of [`Wide::bits`].
+    unsafe fn from_bits(bits: u32) -> Self;
+    /// `a` in the lanes where `self` is all ones, `b` where it is zero.
+    #[inline(always)]
+    unsafe fn select(self, a: Self, b: Self) -> Self {
+        self.and(a).or(self.andnot(b))
+    }
 }
 
 #[cfg(target_arch = "x86_64")]
@@ -67,6 +76,10 @@ impl Wide for __m128 {
     #[inline(always)]
     unsafe fn div(self, o: Self) -> Self {
         _mm_div_ps(self, o)
+    }
+    #[inline(always)]
+    unsafe fn sqrt(self) -> Self {
+        _mm_sqrt_ps(self)
     }
     #[inline(always)]
     unsafe fn min(self, o: Self) -> Self {
@@ -112,6 +125,12 @@ impl Wide for __m128 {
     unsafe fn bits(self) -> u32 {
         _mm_movemask_ps(self) as u32
     }
+    #[inline(always)]
+    unsafe fn from_bits(bits: u32) -> Self {
+        let lane = _mm_setr_epi32(1, 2, 4, 8);
+        let set = _mm_and_si128(_mm_set1_epi32(bits as i32), lane);
+        _mm_castsi128_ps(_mm_cmpeq_epi32(set, lane))
+    }
 }
 
 /// Declares AVX2 methods: `#[inline]` with the feature enabled, as the box kernel's.
@@ -137,6 +156,7 @@ impl Wide for __m256 {
         fn sub(self: Self, o: Self) -> Self { _mm256_sub_ps(self, o) }
         fn mul(self: Self, o: Self) -> Self { _mm256_mul_ps(self, o) }
         fn div(self: Self, o: Self) -> Self { _mm256_div_ps(self, o) }
+        fn sqrt(self: Self) -> Self { _mm256_sqrt_ps(self) }
         fn min(self: Self, o: Self) -> Self { _mm256_min_ps(self, o) }
         fn max(self: Self, o: Self) -> Self { _mm256_max_ps(self, o) }
         fn and(self: Self, o: Self) -> Self { _mm256_and_ps(self, o) }
@@ -148,5 +168,10 @@ impl Wide for __m256 {
         fn gt(self: Self, o: Self) -> Self { _mm256_cmp_ps::<_CMP_GT_OQ>(self, o) }
         fn ge(self: Self, o: Self) -> Self { _mm256_cmp_ps::<_CMP_GE_OQ>(self, o) }
         fn bits(self: Self) -> u32 { _mm256_movemask_ps(self) as u32 }
+        fn from_bits(bits: u32) -> Self {
+            let lane = _mm256_setr_epi32(1, 2, 4, 8, 16, 32, 64, 128);
+            let set = _mm256_and_si256(_mm256_set1_epi32(bits as i32), lane);
+            _mm256_castsi256_ps(_mm256_cmpeq_epi32(set, lane))
+        }
     }
 }
