@@ -66,14 +66,17 @@ mod tests {
             })
             .collect();
         let bytes = encode_layered_exr(3, 2, channels).unwrap();
-        let image = read_all_flat_layers_from_buffered(Cursor::new(bytes)).unwrap();
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("layers.exr");
+        std::fs::write(&path, bytes).unwrap();
+        let image = read_all_flat_layers_from_file(&path).unwrap();
         let layer = &image.layer_data[0];
         let value = |name: &str| {
             let c = layer
                 .channel_data
                 .list
                 .iter()
-                .find(|c| c.name == Text::from(name))
+                .find(|c| c.name == *name)
                 .unwrap_or_else(|| panic!("no channel {name}"));
             c.sample_data.value_by_flat_index(5).to_f32()
         };

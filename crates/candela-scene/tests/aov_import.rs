@@ -87,4 +87,9 @@ fn mitsuba_aov_types_candela_lacks_are_refused_or_skipped() {
     )
     .unwrap_err();
     assert!(e.contains("not NAME:TYPE"), "{e}");
+    let e = mitsuba(r#"<integrator type="aov"/>"#, false).unwrap_err();
+    assert!(
+        e.contains("scene.xml:2:1:") && e.contains("needs an `aovs` list"),
+        "{e}"
+    );
 }

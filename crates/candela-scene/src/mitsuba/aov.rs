@@ -16,7 +16,9 @@ use super::{sensor, Ctx};
 use crate::LoadError;
 
 pub(crate) fn aov_integrator(ctx: &mut Ctx, node: &Node) -> Result<(), LoadError> {
-    let list = node.string("aovs")?.unwrap_or_default();
+    let Some(list) = node.string("aovs")? else {
+        return Err(node.error("the aov integrator needs an `aovs` list of NAME:TYPE"));
+    };
     let mut set = AovSet::NONE;
     if let Some(prop) = node.prop("aovs") {
         for entry in list.split(',').map(str::trim).filter(|e| !e.is_empty()) {
