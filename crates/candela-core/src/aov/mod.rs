@@ -13,8 +13,9 @@
 //! The passes are rendered by [`render_aovs`], a pass of its own beside the path tracer's:
 //! one camera ray per pixel sample through the same sample positions as the beauty's
 //! (same sampler, seed, pixel and index), followed through delta lobes only. It leaves the
-//! path tracer and its film untouched and costs a few percent of the beauty's time (a
-//! path of one to a few rays, no light sampling).
+//! path tracer and its film untouched; it traces one ray per sample (more behind mirrors
+//! and glass) and samples no light, where the beauty traces several with shadow rays:
+//! 0.14 s beside the beauty's 0.86 s on the 128² Cornell box at 16 spp (shared machine).
 
 mod buffer;
 mod render;
