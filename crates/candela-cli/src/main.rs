@@ -7,7 +7,9 @@
 
 mod ies;
 mod info;
+mod layers;
 mod output;
+mod passes;
 mod render;
 mod tonemap;
 

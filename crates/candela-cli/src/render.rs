@@ -20,7 +20,7 @@ use indicatif::{ProgressBar, ProgressStyle};
 use signal_hook::consts::{SIGINT, SIGTERM};
 use signal_hook::flag;
 
-use crate::output::{write_image, ImageFormat, LinearImage};
+use crate::output::ImageFormat;
 use crate::tonemap::{DisplayTransform, Tonemap};
 use crate::UserError;
 
@@ -136,6 +136,8 @@ pub struct RenderArgs {
     /// unless --focus-distance says otherwise.
     #[arg(long, allow_negative_numbers = true)]
     f_number: Option<f32>,
+    #[command(flatten)]
+    passes: crate::passes::PassArgs,
 }
 
 /// Parses a setting's name as scene files spell it, so the two cannot drift apart.
@@ -188,6 +190,7 @@ impl RenderArgs {
         }
         r.sampler = self.sampler.unwrap_or(r.sampler);
         r.isa = self.isa.unwrap_or(r.isa);
+        self.passes.apply(r);
         if self.focus_distance.is_some() || self.f_number.is_some() {
             let lens = desc.camera.lens.get_or_insert_with(LensDesc::default);
             if let Some(d) = self.focus_distance {
@@ -273,6 +276,7 @@ pub fn run(args: RenderArgs) -> Result<ExitCode, UserError> {
         ));
     }
     args.apply_environment(&mut desc)?;
+    let denoiser = args.passes.load_denoiser()?;
     let built = Instant::now();
     let scene = candela_core::build::build(&desc)?;
     let build_s = built.elapsed().as_secs_f64();
@@ -300,17 +304,17 @@ pub fn run(args: RenderArgs) -> Result<ExitCode, UserError> {
     bar.finish_and_clear();
 
     let pixels = result.film.resolve();
-    let image = LinearImage {
-        width: s.width,
-        height: s.height,
-        pixels: &pixels,
-    };
     let display = DisplayTransform {
         exposure: args.exposure,
         tonemap: args.tonemap,
         gamma: args.gamma,
     };
-    write_image(&args.output, &image, &display)?;
+    let passes = pool.install(|| {
+        let (d, cancel) = (denoiser.as_ref(), &interrupt.cancel);
+        crate::passes::finish(&args.passes, d, &scene, pixels, cancel, threads)
+    })?;
+    let passes_summary = passes.summary.clone();
+    passes.write(&args.output, &display)?;
 
     let st = result.stats;
     println!(
@@ -323,6 +327,9 @@ pub fn run(args: RenderArgs) -> Result<ExitCode, UserError> {
         st.rays as f64 / elapsed / 1e6,
         args.output.display()
     );
+    if let Some(line) = passes_summary {
+        println!("{line}");
+    }
     if !scene.instances.is_empty() {
         println!(
             "{} instances of {}: {} triangles stored, {} rendered; built in {:.2} s",

@@ -700,6 +700,8 @@ pub struct RenderSettings {
     /// Which compiled copy of the render loop runs; it must be supported by the CPU
     /// ([`Isa::is_supported`]).
     pub isa: Isa,
+    /// Passes rendered beside the beauty image (see [`crate::aov`]).
+    pub aovs: crate::aov::AovSet,
 }
 
 /// The pixel reconstruction filter (see [`crate::filter`]); radii in pixels.
@@ -735,6 +737,7 @@ impl Default for RenderSettings {
             hide_emitters: false,
             filter: PixelFilterDesc::Box,
             isa: Isa::Auto,
+            aovs: crate::aov::AovSet::NONE,
         }
     }
 }

@@ -30,6 +30,7 @@
 
 pub mod accel;
 pub mod alpha;
+pub mod aov;
 pub mod bsdf;
 pub mod build;
 pub mod bvh;

@@ -858,9 +858,9 @@ fn integrators_with_the_path_tracers_expectation_render_as_it() {
         e.contains("scene.xml:2:27:") && e.contains("max_depth"),
         "{e}"
     );
-    let e = load_err(&scene(r#"<integrator type="aov"/>"#));
+    let e = load_err(&scene(r#"<integrator type="stokes"/>"#));
     assert!(
-        e.contains("scene.xml:2:1:") && e.contains("<integrator type=\"aov\"> is not supported"),
+        e.contains("scene.xml:2:1:") && e.contains("<integrator type=\"stokes\"> is not supported"),
         "{e}"
     );
 }

@@ -5,6 +5,7 @@
 //! each plugin into Candela's description; whatever a plugin leaves unread is an error
 //! naming it (a warning under `lenient`), so nothing is silently dropped.
 
+mod aov;
 mod bsdfs;
 mod conductors;
 mod emitters;

@@ -51,6 +51,9 @@ const PATH_INTEGRATORS: &[(&str, i64)] = &[
 /// they are read and, away from their defaults, warned of.
 pub(crate) fn integrator(ctx: &mut Ctx, node: &Node) -> Result<(), LoadError> {
     let kind = node.kind();
+    if kind == "aov" {
+        return super::aov::aov_integrator(ctx, node);
+    }
     let direct = matches!(kind, "direct" | "direct_projective");
     let default_depth = match PATH_INTEGRATORS.iter().find(|(name, _)| *name == kind) {
         Some(&(_, depth)) => depth,

@@ -191,6 +191,7 @@ struct RenderSection {
     lamp_sampling: Option<LampSampling>,
     ris_candidates: Option<std::num::NonZeroU32>,
     sampler: Option<SamplerKind>,
+    aov: Option<Vec<candela_core::aov::AovKind>>,
 }
 
 fn parse_render(src: &Source, value: Item) -> Result<RenderSettings, LoadError> {
@@ -212,6 +213,7 @@ fn parse_render(src: &Source, value: Item) -> Result<RenderSettings, LoadError> 
         out.ris_candidates = n.get();
     }
     out.sampler = r.sampler.unwrap_or(out.sampler);
+    out.aovs = r.aov.into_iter().flatten().collect();
     Ok(out)
 }
 

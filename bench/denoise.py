@@ -1,0 +1,117 @@
+"""Denoising benchmark (issue #38): on the Cornell box and two other bundled scenes, a
+16-spp render denoised by Intel Open Image Denoise (`candela render --denoise`, guided
+by the albedo and normal passes, and `--denoise=color`, the beauty alone) against the raw
+16- and 256-spp renders, each compared with a 4096-spp reference of the same scene.
+
+Errors: relMSE with the worst 1 % of pixels dropped (per-pixel relMSE, mean over the
+channels, ε = 1e-2; a denoiser rightly softens the edges of directly seen lamps, which
+plain relMSE punishes out of all proportion; plain relMSE is printed too) and HDR-FLIP
+(`flip-evaluator` from PyPI, its default exposure range and 67 pixels per degree).
+Times are candela's own: the path tracer, plus the AOV pass and the denoiser where they
+ran (loading, building and writing excluded), on all the machine's cores.
+
+Run through bench/denoise.sh, which makes target/oidn-venv with pyoidn, numpy and
+flip-evaluator and points OIDN_DIR at the wheel's library.
+"""
+
+import argparse
+import os
+import re
+import subprocess
+import sys
+
+import numpy as np
+
+here = os.path.dirname(os.path.abspath(__file__))
+sys.path.insert(0, here)
+from benchlib import machine, report  # noqa: E402
+from benchlib.images import RELMSE_EPS, read_pfm  # noqa: E402
+
+REPO = os.path.dirname(here)
+# (scene, reduced resolution): a quarter to a half of each scene's own, so that the three
+# 4096-spp references take minutes on a shared 2-core machine.
+SCENES = [
+    ("scenes/cornell.toml", (128, 128)),
+    ("scenes/glass_sphere.toml", (160, 120)),
+    ("scenes/plastics.toml", (240, 80)),
+]
+SUMMARY = re.compile(r"(\d+)x(\d+), (\d+) spp, ([\d.]+) s,")
+PASSES = re.compile(r"passes [a-z, ]+ in ([\d.]+) s")
+DENOISED = re.compile(r"denoised \([^)]*\) in ([\d.]+) s")
+DROP = 0.01
+
+
+def render(binary, scene, out, res, spp, seed, extra=()):
+    """Renders and returns candela's time: path tracer + AOV pass + denoiser."""
+    cmd = [binary, "render", scene, "-o", out, "--spp", str(spp), "--seed", str(seed),
+           "--res", f"{res[0]}x{res[1]}", *extra]
+    p = subprocess.run(cmd, cwd=REPO, capture_output=True, text=True)
+    if p.returncode != 0:
+        raise RuntimeError(f"{' '.join(cmd)} failed ({p.returncode}):\n{p.stderr}{p.stdout}")
+    total = 0.0
+    for pattern in (SUMMARY, PASSES, DENOISED):
+        m = pattern.search(p.stdout)
+        if m:
+            total += float(m.groups()[-1])
+    return total
+
+
+def per_pixel_relmse(x, ref):
+    return ((x - ref) ** 2 / (ref ** 2 + RELMSE_EPS)).mean(axis=-1).ravel()
+
+
+def relmse_dropped(x, ref):
+    e = np.sort(per_pixel_relmse(x, ref))
+    return float(e[: int(round(len(e) * (1.0 - DROP)))].mean())
+
+
+def flip_hdr(x, ref):
+    import flip_evaluator as flip
+    _, mean, _ = flip.evaluate(np.ascontiguousarray(ref, dtype=np.float32),
+                               np.ascontiguousarray(np.maximum(x, 0.0), dtype=np.float32),
+                               "HDR", applyMagma=False)
+    return float(mean)
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--binary", default=os.path.join(REPO, "target/release/candela"))
+    ap.add_argument("--ref-spp", type=int, default=4096)
+    ap.add_argument("--out", default=os.path.join(here, "out/denoise"))
+    a = ap.parse_args()
+    os.makedirs(a.out, exist_ok=True)
+    info = machine.describe(REPO)
+    print(f"{info['date']}, {info['git']}, {info['cpu']} ({info['nproc']} threads), "
+          f"load before {machine.loadavg()}", flush=True)
+    variants = [
+        ("raw", 16, ()),
+        ("raw", 256, ()),
+        ("denoised, albedo + normal", 16, ("--denoise",)),
+        ("denoised, beauty alone", 16, ("--denoise=color",)),
+        ("denoised, albedo + normal", 64, ("--denoise",)),
+    ]
+    rows = []
+    for scene, res in SCENES:
+        name = os.path.splitext(os.path.basename(scene))[0]
+        ref_path = os.path.join(a.out, f"{name}-ref{a.ref_spp}.pfm")
+        if not os.path.exists(ref_path):
+            t = render(a.binary, scene, ref_path, res, a.ref_spp, seed=1)
+            print(f"{name}: reference {a.ref_spp} spp in {t:.1f} s", flush=True)
+        ref = read_pfm(ref_path)
+        for label, spp, extra in variants:
+            out = os.path.join(a.out, f"{name}-{spp}-{'-'.join(extra) or 'raw'}.pfm")
+            t = render(a.binary, scene, out, res, spp, seed=2, extra=extra)
+            x = read_pfm(out)
+            assert np.isfinite(x).all(), out
+            plain = float(per_pixel_relmse(x, ref).mean())
+            row = [f"{name} {res[0]}×{res[1]}", label, spp, f"{t:.2f}",
+                   f"{relmse_dropped(x, ref):.5f}", f"{plain:.5f}", f"{flip_hdr(x, ref):.4f}"]
+            print(" | ".join(map(str, row)), flush=True)
+            rows.append(row)
+    print(f"load after {machine.loadavg()}\n")
+    print(report.table(["scene", "image", "spp", "time (s)", "relMSE, worst 1 % dropped",
+                        "relMSE", "HDR-FLIP"], rows, "llrrrrr"))
+
+
+if __name__ == "__main__":
+    main()
