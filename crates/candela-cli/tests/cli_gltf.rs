@@ -126,7 +126,10 @@ fn no_lights_means_a_default_sky_and_env_flags_relight() {
         assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
         assert_ne!(pfm_mean(&dir.path().join("c.pfm")), a);
     } else {
-        eprintln!("skipped: ../shared/data not found (--env with {} is absent)", sky.display());
+        eprintln!(
+            "skipped: ../shared/data not found (--env with {} is absent)",
+            sky.display()
+        );
     }
     // Scene 1 is empty: it renders (the sky alone); scene 2 does not exist.
     let o = candela(&[

@@ -29,7 +29,10 @@ fn model(rel: &str) -> Option<PathBuf> {
     if p.exists() {
         Some(p)
     } else {
-        eprintln!("skipped: ../shared/data not found ({} is absent)", p.display());
+        eprintln!(
+            "skipped: ../shared/data not found ({} is absent)",
+            p.display()
+        );
         None
     }
 }

@@ -32,7 +32,9 @@ fn data_dir() -> Option<&'static Path> {
     if p.is_dir() {
         Some(p)
     } else {
-        eprintln!("skipped: ../shared/data not found (the optional Mitsuba scenes and reference renders)");
+        eprintln!(
+            "skipped: ../shared/data not found (the optional Mitsuba scenes and reference renders)"
+        );
         None
     }
 }
