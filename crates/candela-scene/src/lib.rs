@@ -46,9 +46,11 @@ mod toml_environment;
 mod toml_include;
 mod toml_light;
 mod toml_material;
+mod toml_media;
 pub mod toml_scene;
 mod toml_shape;
 mod toml_values;
+pub mod vol;
 
 pub use toml_scene::parse_toml_scene;
 
