@@ -24,8 +24,8 @@ use crate::medium::{transmittance, HenyeyGreenstein, MediumId, MediumInterface, 
 use crate::sampler::{mix64, Pcg32, Sampler};
 use crate::scene::{Scene, SurfaceInteraction};
 
-/// Null surfaces one ray may cross before it is given up (a guard against a ray caught
-/// between coincident boundaries).
+/// Null surfaces a path may cross between two scattering events, or a shadow ray in all,
+/// before it is given up (a guard against a ray caught between coincident boundaries).
 const MAX_CROSSINGS: u32 = 256;
 
 #[inline]
@@ -134,6 +134,7 @@ pub(crate) fn li<S: Sampler>(
                     // Exact sampling: the phase function's value over its density is 1.
                     let (wi, pdf) = phase.sample(ray.d, sampler.get_2d());
                     path.r_l = path.r_u / pdf;
+                    crossings = 0;
                     prev_ctx = ctx;
                     specular = false;
                     ray = Ray::new(c.p, wi);
@@ -216,6 +217,7 @@ pub(crate) fn li<S: Sampler>(
             break;
         }
         depth += 1;
+        crossings = 0;
         let bsdf = scene.materials[si.material.0 as usize].bsdf_at(&si);
         let ctx = ShadingCtx { p: si.p, n: si.ns };
         if !bsdf.is_delta() {

@@ -35,10 +35,18 @@ pub(crate) fn medium(ctx: &mut Ctx, node: &Node) -> Result<String, LoadError> {
         }
         "heterogeneous" => heterogeneous(ctx, node, scale)?,
         _ => {
-            return Err(node.error(format!(
-                "<{}> is not supported (homogeneous and heterogeneous are)",
-                describe(node)
-            )))
+            ctx.unsupported(
+                node,
+                format!(
+                    "<{}> is not supported (homogeneous and heterogeneous are)",
+                    describe(node)
+                ),
+            )?;
+            // Under --lenient: vacuum, so that what refers to it still loads.
+            MediumKindDesc::Homogeneous {
+                sigma_t: Vec3::ZERO,
+                albedo: Vec3::ZERO,
+            }
         }
     };
     let mut phase = PhaseDesc::Isotropic;
