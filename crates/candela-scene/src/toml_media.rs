@@ -88,7 +88,7 @@ pub(crate) fn parse_media(
                 let (grid, box_) = load_grid(src, base, file)?;
                 let mut to_world = compose(src, e.transform.unwrap_or_default())?;
                 if e.use_grid_bbox.unwrap_or(false) {
-                    to_world = to_world * box_;
+                    to_world *= box_;
                 }
                 let albedo = match (&e.albedo_file, e.albedo) {
                     (Some(f), None) => VolumeDesc::Grid(load_grid(src, base, f)?.0),

@@ -389,7 +389,7 @@ fn shadow_transmittance(
         let (d, t_max) = if finite {
             let d = target - o;
             let dist = d.length();
-            if !(dist > 0.0) {
+            if dist.is_nan() || dist <= 0.0 {
                 return Some(tr);
             }
             // A relative margin keeps the far end from blocking itself.

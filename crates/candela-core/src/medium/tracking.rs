@@ -59,7 +59,7 @@ impl<'a> MajorantTracker<'a> {
             f32::INFINITY
         };
         let t = self.t + dt;
-        if !(t < seg.t1) {
+        if t.is_nan() || t >= seg.t1 {
             self.t_maj_end = transmittance(sigma_maj, seg.t1 - self.t);
             self.segment = None;
             return None;
