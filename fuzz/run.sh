@@ -30,6 +30,7 @@ seeds_ies() { files '*.ies'; }
 seeds_mitsuba() { files '*.xml'; }
 seeds_exr() { files '*.exr'; }
 seeds_gltf() { files '*.gltf' '*.glb'; }
+seeds_vol() { files '*.vol'; }
 seeds_image() { :; }
 
 corpus=$here/corpus/$target

@@ -31,6 +31,7 @@ use crate::scene::{Mesh, Prim, Scene, Sphere};
 use crate::texture::ImageTexture;
 
 mod lights;
+mod media;
 
 pub use lights::LUMENS_PER_WATT;
 
@@ -125,6 +126,7 @@ pub fn build(desc: &SceneDesc) -> Result<Scene, BuildError> {
     let mut object_mesh: HashMap<*const MeshDesc, u32> = HashMap::new();
     let mut object_meshes = Vec::new();
     let mut instances = Vec::new();
+    let mut media = media::MediaBuilder::new(desc)?;
     for (shape_index, shape) in desc.shapes.iter().enumerate() {
         let Some(&material) = material_ids.get(shape.material.as_str()) else {
             return err(
@@ -132,6 +134,7 @@ pub fn build(desc: &SceneDesc) -> Result<Scene, BuildError> {
                 format!("unknown material \"{}\"", shape.material),
             );
         };
+        let material = media.shape_material(shape_index, material, &mut materials, &mut alphas);
         if let Some(le) = shape.emission {
             check_color(&shape.span, "emission", le)?;
         }
@@ -266,6 +269,7 @@ pub fn build(desc: &SceneDesc) -> Result<Scene, BuildError> {
         .map(|(i, _)| LightId(i as u32))
         .collect();
 
+    let materials_len = materials.len();
     Ok(Scene {
         camera,
         filter,
@@ -279,6 +283,7 @@ pub fn build(desc: &SceneDesc) -> Result<Scene, BuildError> {
         prims,
         accel,
         instances,
+        media: media.finish(materials_len),
     })
 }
 
@@ -589,6 +594,10 @@ fn build_material(bsdf: &BsdfDesc, span: &Span) -> Result<Material, BuildError> 
     Ok(match bsdf {
         BsdfDesc::Diffuse { albedo } => Material::Diffuse {
             albedo: build_texture(albedo, span, "albedo")?,
+        },
+        // Never shaded: the volumetric integrator passes through null surfaces.
+        BsdfDesc::Null => Material::Diffuse {
+            albedo: Texture::Constant(Vec3::ZERO),
         },
         BsdfDesc::Conductor {
             eta,

@@ -11,6 +11,10 @@ use std::sync::Arc;
 
 use glam::{Affine2, Mat3, Mat4, Vec2, Vec3, Vec4};
 
+mod media;
+
+pub use media::*;
+
 /// Where an item of a description came from: `file:line:col` (1-based). Items made in code
 /// have an empty file name and line 0.
 #[derive(Clone, Debug, Default, PartialEq, Eq)]
@@ -58,6 +62,8 @@ pub struct SceneDesc {
     pub render: RenderSettings,
     /// Goniometric profiles attached to emitting shapes (IES-shaped area lights).
     pub emission_profiles: Vec<EmissionProfileDesc>,
+    /// Participating media and the shapes that bound them.
+    pub media: MediaDesc,
 }
 
 /// A camera placed by position, target and up vector.
@@ -165,6 +171,9 @@ pub struct MaterialDesc {
 pub enum BsdfDesc {
     /// Lambertian reflection with the given albedo.
     Diffuse { albedo: TextureDesc },
+    /// No surface at all: rays pass straight through. Only a medium's boundary (Mitsuba's
+    /// `null` BSDF).
+    Null,
     /// A metal with complex index η + ik per channel (see
     /// [`crate::bsdf::metal_preset`] for named metals); α along the tangent and bitangent.
     Conductor {

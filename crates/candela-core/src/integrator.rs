@@ -20,6 +20,8 @@ use crate::sampler::{IndependentSampler, Sampler, SobolCmjSampler, SobolSampler}
 use crate::sampling::{balance_heuristic, power_heuristic};
 use crate::scene::{Scene, SurfaceInteraction};
 
+mod volpath;
+
 /// Rows per parallel work item.
 const BAND_ROWS: usize = 4;
 
@@ -230,6 +232,9 @@ fn li_isa<S: Sampler, const V3: bool>(
     sampler: &mut S,
     rays: &mut u64,
 ) -> Vec3 {
+    if let Some(media) = scene.media.as_deref() {
+        return volpath::li(scene, media, ray, sampler, rays);
+    }
     let mode = scene.settings.mis;
     let mut l = Vec3::ZERO;
     let mut beta = Vec3::ONE;

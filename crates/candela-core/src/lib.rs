@@ -48,6 +48,7 @@ pub mod light;
 pub mod light_sampler;
 pub mod material;
 pub mod math;
+pub mod medium;
 pub mod photometry;
 pub mod sampler;
 pub mod sampling;

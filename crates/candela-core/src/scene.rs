@@ -198,6 +198,8 @@ pub struct Scene {
     pub accel: Accel,
     /// Meshes shared by several shapes, stored once and placed by transforms.
     pub instances: Instances,
+    /// Participating media and null surfaces; where set, the volumetric path tracer renders.
+    pub media: Option<Box<crate::medium::SceneMedia>>,
 }
 
 impl Scene {

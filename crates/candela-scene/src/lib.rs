@@ -41,6 +41,7 @@ mod mesh_scene;
 pub mod obj;
 pub mod ply;
 pub mod toml;
+pub mod vol;
 
 pub use crate::toml::parse_toml_scene;
 

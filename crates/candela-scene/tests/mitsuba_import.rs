@@ -881,8 +881,8 @@ fn unsupported_elements_are_errors_naming_them_or_warnings_when_lenient() {
             "<shape type=\"hair\"> is not supported",
         ),
         (
-            "<medium type=\"homogeneous\"/>",
-            "<medium type=\"homogeneous\"> is not supported",
+            "<medium type=\"rayleigh\"/>",
+            "<medium type=\"rayleigh\"> is not supported",
         ),
         (
             "<shape type=\"cube\"><float name=\"radius\" value=\"2\"/></shape>",

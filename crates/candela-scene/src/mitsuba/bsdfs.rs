@@ -94,6 +94,8 @@ fn bsdf(ctx: &mut Ctx, node: &Node) -> Result<BsdfDesc, LoadError> {
 fn two_sided(ctx: &mut Ctx, node: &Node) -> Result<BsdfDesc, LoadError> {
     let kind = node.kind();
     let d = match kind {
+        // A medium's boundary: rays pass through (see `candela_core::medium`).
+        "null" => BsdfDesc::Null,
         "diffuse" => BsdfDesc::Diffuse {
             albedo: ctx.texture(node, "reflectance", Vec3::splat(0.5))?,
         },

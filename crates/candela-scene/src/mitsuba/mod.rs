@@ -9,6 +9,7 @@ mod aov;
 mod bsdfs;
 mod conductors;
 mod emitters;
+mod media;
 mod parse;
 mod sensor;
 pub mod serialized;
@@ -56,6 +57,7 @@ fn map_scene(root: Node, path: &Path, options: &LoadOptions) -> Result<LoadedSce
         texture_ids: HashMap::new(),
         shape_groups: HashMap::new(),
         mesh_files: HashMap::new(),
+        medium_ids: std::collections::HashSet::new(),
         desc: SceneDesc::default(),
     };
     // Mitsuba's default integrator is `path` with unlimited depth.
@@ -80,6 +82,11 @@ fn map_scene(root: Node, path: &Path, options: &LoadOptions) -> Result<LoadedSce
             ctx.bsdf_ids.insert(id.to_string(), name);
         }
     }
+    // Named media, before the shapes and sensor that refer to them.
+    for c in root.children.iter().filter(|c| c.tag == "medium") {
+        let name = media::medium(&mut ctx, c)?;
+        ctx.medium_ids.insert(name);
+    }
     // Shape groups next, so that instances may come before or after their group.
     for c in root
         .children
@@ -90,7 +97,7 @@ fn map_scene(root: Node, path: &Path, options: &LoadOptions) -> Result<LoadedSce
     }
     for c in &root.children {
         match c.tag.as_str() {
-            "bsdf" | "texture" => {}
+            "bsdf" | "texture" | "medium" => {}
             "shape" => shapes::shape(&mut ctx, c)?,
             "emitter" => emitters::emitter(&mut ctx, c)?,
             "sensor" => sensor::sensor(&mut ctx, c)?,
@@ -123,6 +130,8 @@ pub(crate) struct Ctx {
     pub shape_groups: HashMap<String, Vec<ShapeDesc>>,
     /// Meshes loaded so far.
     pub mesh_files: HashMap<MeshKey, Arc<MeshDesc>>,
+    /// Names of the top-level media (their ids).
+    pub medium_ids: std::collections::HashSet<String>,
     pub desc: SceneDesc,
 }
 

@@ -123,7 +123,7 @@ impl Node {
     /// A conductor's `eta` and `k` are unbounded; other colours are reflectances.
     pub fn color(&self, name: &str) -> Result<Option<Vec3>, LoadError> {
         let use_ = match name {
-            "eta" | "k" => SpectrumUse::Unbounded,
+            "eta" | "k" | "sigma_t" => SpectrumUse::Unbounded,
             _ => SpectrumUse::Reflectance,
         };
         self.colour_as(name, use_)

@@ -32,9 +32,9 @@ pub fn candela_max_depth(m: i64) -> Result<u32, String> {
 }
 
 /// The integrators whose image is the path tracer's in expectation, with the `max_depth`
-/// each takes by default (Mitsuba 3.9.1): the volumetric ones (no media here, which the
-/// importer refuses), the particle tracer, and the differentiable ones, whose primal
-/// image is a path tracer's.
+/// each takes by default (Mitsuba 3.9.1): the volumetric ones (a scene with media renders
+/// with Candela's volumetric path tracer whichever is named), the particle tracer, and the
+/// differentiable ones, whose primal image is a path tracer's.
 const PATH_INTEGRATORS: &[(&str, i64)] = &[
     ("path", -1),
     ("volpath", -1),
@@ -124,6 +124,7 @@ pub(crate) fn sensor(ctx: &mut Ctx, node: &Node) -> Result<(), LoadError> {
     for s in node.plugins("sampler") {
         sampler(ctx, s)?;
     }
+    super::media::sensor_medium(ctx, node)?;
     let to_world = match node.prop("to_world") {
         Some(t) => transform::transform(t)?,
         None => Mat4::IDENTITY,

@@ -20,8 +20,12 @@ pub(crate) fn shape(ctx: &mut Ctx, node: &Node) -> Result<(), LoadError> {
         "shapegroup" => Ok(()),
         "instance" => instance(ctx, node),
         _ => {
-            if let Some(s) = shape_desc(ctx, node)? {
-                ctx.desc.shapes.push(s);
+            let index = ctx.desc.shapes.len();
+            super::media::shape_media(ctx, node, index)?;
+            match shape_desc(ctx, node)? {
+                Some(s) => ctx.desc.shapes.push(s),
+                // Skipped under --lenient: its media bound nothing.
+                None => ctx.desc.media.shapes.retain(|m| m.shape != index),
             }
             Ok(())
         }
@@ -222,7 +226,8 @@ fn material(ctx: &mut Ctx, node: &Node) -> Result<String, LoadError> {
     for c in &node.children {
         let name = match c.tag.as_str() {
             "bsdf" => bsdfs::material(ctx, c)?,
-            "ref" => {
+            // A medium's reference is the shape's medium, not its BSDF.
+            "ref" if !matches!(c.name(), "interior" | "exterior") => {
                 let id = c.req("id")?;
                 match ctx.bsdf_ids.get(id) {
                     Some(n) => n.clone(),
@@ -258,7 +263,7 @@ fn reads_uv(ctx: &Ctx, material: &str) -> bool {
             BsdfDesc::NormalMap { .. } | BsdfDesc::Alpha { .. } => true,
             BsdfDesc::TwoSided(inner) | BsdfDesc::OneSided(inner) => bsdf(inner),
             BsdfDesc::Mix { weight, a, b } => texture(weight) || bsdf(a) || bsdf(b),
-            BsdfDesc::Conductor { .. } | BsdfDesc::Dielectric { .. } => false,
+            BsdfDesc::Conductor { .. } | BsdfDesc::Dielectric { .. } | BsdfDesc::Null => false,
         }
     }
     ctx.desc

@@ -25,6 +25,7 @@ pub(crate) const MATERIAL_TYPES: &[&str] = &[
     "plastic",
     "metal_rough",
     "mix",
+    "null",
 ];
 
 /// A texturable value: one number, `[r, g, b]`, or a texture table.
@@ -214,6 +215,7 @@ pub(crate) fn parse_material(
         "diffuse" => BsdfDesc::Diffuse {
             albedo: tex(m.albedo, Vec3::splat(DEFAULT_ALBEDO), Slot::Color)?,
         },
+        "null" => BsdfDesc::Null,
         "conductor" => {
             let (alpha_u, alpha_v) = alpha(&m);
             let (eta, k) = match (m.preset, m.eta, m.k) {

@@ -1,6 +1,6 @@
 //! Candela's TOML scene format (documented in `docs/scene-format.md`): `[render]`,
 //! `[camera]`, `[materials.NAME]`, `[[shape]]`, `[[light]]`, `[environment]` and
-//! `[[include]]` (glTF files).
+//! `[[include]]` (glTF files), `[media.NAME]`.
 //!
 //! The document is first parsed into `toml`'s span-keeping tree ([`DeTable`]); each section
 //! is then deserialized on its own with `deny_unknown_fields`, so every error (unknown
@@ -13,6 +13,7 @@ mod environment;
 mod include;
 mod light;
 mod material;
+mod media;
 pub(crate) mod shape;
 mod values;
 
@@ -20,7 +21,7 @@ use std::path::Path;
 
 use candela_core::desc::{
     BsdfDesc, EmissionProfileDesc, LampSampling, LightSamplerKind, MaterialDesc, MisMode,
-    RenderSettings, SamplerKind, SceneDesc,
+    RenderSettings, SamplerKind, SceneDesc, ShapeMediaDesc,
 };
 use serde::de::DeserializeOwned;
 use serde::Deserialize;
@@ -33,6 +34,7 @@ use environment::parse_environment;
 use include::parse_include;
 use light::parse_light;
 use material::{parse_material, MATERIAL_TYPES};
+use media::{parse_media, take_keys};
 use shape::parse_shape;
 
 /// One item of the parsed tree: a value and its byte range in the text.
@@ -61,12 +63,32 @@ pub fn parse_toml_scene_with_warnings(
         let key_at = key.span().start;
         match key.get_ref().as_ref() {
             "render" => desc.render = parse_render(&src, value)?,
-            "camera" => desc.camera = parse_camera(&src, base, key_at, value)?,
+            "camera" => {
+                let mut value = value;
+                let [medium] =
+                    <[_; 1]>::try_from(take_keys(&src, &mut value, &["medium"])?).expect("one key");
+                if let Some((name, at)) = medium {
+                    desc.media.camera = Some(name);
+                    desc.media.camera_span = src.span(at);
+                }
+                desc.camera = parse_camera(&src, base, key_at, value)?
+            }
+            "media" => desc.media.media = parse_media(&src, base, value)?,
             "materials" => desc.materials = parse_materials(&src, base, value)?,
             "shape" => {
-                for item in array_of_tables(&src, "shape", value)? {
+                for mut item in array_of_tables(&src, "shape", value)? {
+                    let at = item.span().start;
+                    let sides = take_keys(&src, &mut item, &["interior", "exterior"])?;
                     let (shapes, profile) = parse_shape(&src, base, item, &mut mesh_files)?;
                     for shape in shapes {
+                        if sides.iter().any(Option::is_some) {
+                            desc.media.shapes.push(ShapeMediaDesc {
+                                shape: desc.shapes.len(),
+                                interior: sides[0].as_ref().map(|s| s.0.clone()),
+                                exterior: sides[1].as_ref().map(|s| s.0.clone()),
+                                span: src.span(at),
+                            });
+                        }
                         if let Some((table, span)) = &profile {
                             desc.emission_profiles.push(EmissionProfileDesc {
                                 shape: desc.shapes.len(),
@@ -99,7 +121,7 @@ pub fn parse_toml_scene_with_warnings(
                     key_at,
                     format!(
                         "unknown key `{other}`, expected one of `render`, `camera`, \
-                         `materials`, `shape`, `light`, `environment`, `include`"
+                         `materials`, `shape`, `light`, `environment`, `include`, `media`"
                     ),
                 ))
             }
