@@ -40,6 +40,7 @@ pub mod limits;
 mod mesh_scene;
 pub mod obj;
 pub mod ply;
+mod ply_body;
 pub mod serialized;
 mod toml_camera;
 mod toml_environment;
