@@ -244,8 +244,8 @@ fn honest_large_files_stay_within_the_multiple() {
         ascii.len()
     );
     // The reader puts each number in its place in the mesh, 4 bytes for at least 2 of
-    // the file (two uvs' worth of normals and colours aside).
-    assert!(peak <= 2 * ascii.len() as u64, "{ratio:.1}x its size");
+    // the file: twice its size, and the header's own structures.
+    assert!(peak <= 3 * ascii.len() as u64, "{ratio:.1}x its size");
     assert!(peak <= allocation_budget(ascii.len()));
     // Twenty times as many vertices load in the same proportion.
     let big_header = header.replace("element vertex 90000", "element vertex 1800000");
@@ -256,7 +256,7 @@ fn honest_large_files_stay_within_the_multiple() {
     let (r, peak) = peak_of(|| candela_scene::ply::parse_ply(&big, Path::new("b.ply")));
     assert!(r.unwrap_err().message.contains("no faces"));
     assert!(
-        peak <= 2 * big.len() as u64,
+        peak <= 3 * big.len() as u64,
         "peak {peak} bytes for {}",
         big.len()
     );
