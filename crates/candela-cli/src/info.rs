@@ -10,6 +10,7 @@ use crate::UserError;
 pub fn run(path: &Path, load: &LoadArgs) -> Result<(), UserError> {
     let desc = load.load(path)?;
     let scene = candela_core::build::build(&desc)?;
+    let memory = crate::footprint::describe(&scene);
     let s = &scene.settings;
     let b = scene.bounds();
     let count = |f: fn(&Light) -> bool| scene.lights.iter().filter(|l| f(l)).count();
@@ -64,6 +65,7 @@ pub fn run(path: &Path, load: &LoadArgs) -> Result<(), UserError> {
         b.min.to_array(),
         b.max.to_array()
     );
+    println!("memory     {memory}");
     println!(
         "render     {}x{}, {} spp, max depth {}, seed {}, mis {:?}, light sampler {:?}, \
          lamp sampling {:?}",

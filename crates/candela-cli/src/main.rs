@@ -5,6 +5,7 @@
 //! SIGTERM (the partial image is still written), 101 an
 //! internal bug.
 
+mod footprint;
 mod ies;
 mod info;
 mod layers;

@@ -267,7 +267,9 @@ impl Interrupt {
 pub fn run(args: RenderArgs) -> Result<ExitCode, UserError> {
     // Fail on a bad output name before spending any time rendering.
     ImageFormat::from_path(&args.output)?;
+    let loaded = Instant::now();
     let mut desc = args.load.load(&args.scene)?;
+    let load_s = loaded.elapsed().as_secs_f64();
     args.apply_overrides(&mut desc);
     if !desc.render.isa.is_supported() {
         // Auto and baseline run anywhere: only v3 can be refused.
@@ -278,7 +280,7 @@ pub fn run(args: RenderArgs) -> Result<ExitCode, UserError> {
     args.apply_environment(&mut desc)?;
     let denoiser = args.passes.load_denoiser()?;
     let built = Instant::now();
-    let scene = candela_core::build::build(&desc)?;
+    let scene = candela_core::build::build_owned(desc)?;
     let build_s = built.elapsed().as_secs_f64();
     let s = &scene.settings;
 
@@ -340,6 +342,12 @@ pub fn run(args: RenderArgs) -> Result<ExitCode, UserError> {
             build_s
         );
     }
+    println!(
+        "load {load_s:.2} s, build {build_s:.2} s, render {elapsed:.2} s; scene {}; peak memory {}",
+        crate::footprint::describe(&scene),
+        crate::footprint::peak_resident_bytes()
+            .map_or("unknown".into(), crate::footprint::megabytes)
+    );
     let rejected = result.film.rejected_samples();
     if rejected > 0 {
         println!("{rejected} non-finite samples were dropped");

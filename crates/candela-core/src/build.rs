@@ -8,7 +8,7 @@ use std::sync::Arc;
 
 use glam::{Mat3, Mat4, Vec2, Vec3};
 
-use crate::accel::{Accel, Shape};
+use crate::accel::{Accel, NodeLayout, Shape, Simd};
 use crate::alpha::{AlphaMask, AlphaMode};
 use crate::bsdf::{
     Conductor, ConductorFresnel, Dielectric, Lobe, Microfacet, MicrofacetDistribution, Plastic,
@@ -93,6 +93,27 @@ pub fn check_resolution(width: u32, height: u32) -> Result<(), String> {
 
 /// Validates a description and builds the scene.
 pub fn build(desc: &SceneDesc) -> Result<Scene, BuildError> {
+    build_taking(desc, Vec::new())
+}
+
+/// [`build`], consuming the description: each mesh that one shape alone holds is moved
+/// into the scene rather than copied (and transformed to world space in place), so that
+/// a big scene's geometry is in memory once, not twice.
+pub fn build_owned(mut desc: SceneDesc) -> Result<Scene, BuildError> {
+    let taken = desc
+        .shapes
+        .iter_mut()
+        .map(|shape| match &mut shape.geometry {
+            GeometryDesc::Mesh(m) => Arc::get_mut(m).map(std::mem::take),
+            _ => None,
+        })
+        .collect();
+    build_taking(&desc, taken)
+}
+
+/// [`build`] with the meshes of `taken[shape]`, where given, in place of the
+/// description's (which [`build_owned`] has emptied).
+fn build_taking(desc: &SceneDesc, mut taken: Vec<Option<MeshDesc>>) -> Result<Scene, BuildError> {
     let r = &desc.render;
     if let Err(m) = check_resolution(r.width, r.height) {
         return err(&Span::code(), m);
@@ -197,8 +218,10 @@ pub fn build(desc: &SceneDesc) -> Result<Scene, BuildError> {
             geometry => {
                 let local = match geometry {
                     GeometryDesc::Mesh(m) => {
-                        validate_mesh(m, &shape.span)?;
-                        MeshDesc::clone(m)
+                        let own = taken.get_mut(shape_index).and_then(Option::take);
+                        let m = own.unwrap_or_else(|| MeshDesc::clone(m));
+                        validate_mesh(&m, &shape.span)?;
+                        m
                     }
                     GeometryDesc::Rectangle => rectangle(),
                     GeometryDesc::Disk => disk(128),
@@ -222,33 +245,38 @@ pub fn build(desc: &SceneDesc) -> Result<Scene, BuildError> {
         lights.push(lights::build_light(l)?);
     }
 
-    let mut prims = Vec::new();
-    let mut shapes = Vec::new();
+    let triangles: usize = meshes.iter().map(|m| m.indices.len()).sum();
+    let mut prims = Vec::with_capacity(triangles + spheres.len());
     for (mi, m) in meshes.iter().enumerate() {
-        for tri in 0..m.indices.len() as u32 {
-            prims.push(Prim::Triangle {
-                mesh: mi as u32,
-                tri,
-            });
-            shapes.push(Shape::Triangle(m.vertices(tri)));
-        }
+        prims.extend((0..m.indices.len() as u32).map(|tri| Prim::Triangle {
+            mesh: mi as u32,
+            tri,
+        }));
     }
-    for (si, s) in spheres.iter().enumerate() {
-        prims.push(Prim::Sphere(si as u32));
-        shapes.push(Shape::Sphere {
-            center: s.center,
-            radius: s.radius,
-        });
-    }
+    prims.extend((0..spheres.len() as u32).map(Prim::Sphere));
+    // Each primitive's shape as the accelerator needs it, made when asked rather than
+    // held in an array beside the meshes.
+    let shape = |i: u32| match prims[i as usize] {
+        Prim::Triangle { mesh, tri } => Shape::Triangle(meshes[mesh as usize].vertices(tri)),
+        Prim::Sphere(s) => Shape::Sphere {
+            center: spheres[s as usize].center,
+            radius: spheres[s as usize].radius,
+        },
+    };
     // Only triangles of alpha-masked meshes pay for the filter.
-    let accel = Accel::build(&shapes, |i| match prims[i as usize] {
-        Prim::Triangle { mesh, .. } => meshes[mesh as usize].alpha.is_some(),
-        Prim::Sphere(_) => false,
-    });
+    let accel = Accel::build_indexed(
+        prims.len(),
+        shape,
+        |i| match prims[i as usize] {
+            Prim::Triangle { mesh, .. } => meshes[mesh as usize].alpha.is_some(),
+            Prim::Sphere(_) => false,
+        },
+        Simd::best(),
+        NodeLayout::Full,
+    );
     let instances = Instances::new(object_meshes, instances);
-    let bounds = shapes
-        .iter()
-        .map(Shape::bounds)
+    let bounds = (0..prims.len() as u32)
+        .map(|i| shape(i).bounds())
         .chain((!instances.is_empty()).then(|| instances.bounds()))
         .reduce(Aabb::union);
     let scene_radius = bounds.map_or(1.0, |b| (0.5 * (b.max - b.min).length()).max(1e-3));
@@ -850,11 +878,12 @@ fn validate_mesh(m: &MeshDesc, span: &Span) -> Result<(), BuildError> {
 fn to_world(local: MeshDesc, m: Mat4, material: MaterialId) -> Mesh {
     let xf = Transform::new(m);
     Mesh {
-        positions: local.positions.iter().map(|&p| xf.point(p)).collect(),
-        normals: local.normals.iter().map(|&n| xf.normal(n)).collect(),
+        // Through `into_iter`: the vectors are reused, not copied.
+        positions: local.positions.into_iter().map(|p| xf.point(p)).collect(),
+        normals: local.normals.into_iter().map(|n| xf.normal(n)).collect(),
         uvs: local.uvs,
         colors: local.colors,
-        tangents: local.tangents.iter().map(|&t| xf.tangent(t)).collect(),
+        tangents: local.tangents.into_iter().map(|t| xf.tangent(t)).collect(),
         indices: local.indices,
         material,
         lights: Vec::new(),

@@ -40,6 +40,7 @@ pub mod limits;
 mod mesh_scene;
 pub mod obj;
 pub mod ply;
+mod ply_body;
 pub mod toml;
 pub mod vol;
 

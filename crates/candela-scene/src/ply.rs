@@ -1,21 +1,19 @@
 //! Stanford PLY meshes (ascii and binary) through `ply-rs-bw`: a `vertex` element with
 //! `x y z`, optional `nx ny nz`, uvs (`u v`, `s t` or `texture_u texture_v`) and colours
-//! (`red green blue` or `r g b`; see [`color_channel`]), and a
+//! (`red green blue` or `r g b`: 8- and 16-bit channels sRGB-decoded, floats linear), and a
 //! `face` element whose `vertex_indices` (or `vertex_index`) lists are triangulated as
 //! fans. Counts declared in the header are checked against the file size before anything
-//! is read, so a truncated or hostile file cannot ask for a huge allocation.
+//! is read, so a truncated or hostile file cannot ask for a huge allocation. `ply-rs`
+//! reads the header; [`crate::ply_body`] reads the body straight into the mesh's arrays.
 
 use std::io::Cursor;
 use std::path::Path;
 
-use candela_core::color::srgb_decode;
 use candela_core::desc::MeshDesc;
-use glam::{Vec2, Vec3};
 use ply_rs_bw::parser::{ParseError, Parser, Reader};
-use ply_rs_bw::ply::{
-    DefaultElement, ElementDef, Encoding, Header, Property, PropertyType, ScalarType,
-};
+use ply_rs_bw::ply::{DefaultElement, ElementDef, Encoding, Header, PropertyType, ScalarType};
 
+use crate::ply_body::read_body;
 use crate::MeshError;
 
 /// Loads a PLY file into one mesh.
@@ -35,7 +33,6 @@ pub fn parse_ply(bytes: &[u8], path: &Path) -> Result<MeshDesc, MeshError> {
         .map_err(|e| err(e.line(), one_line(&e)))?;
     let body = bytes.len() - reader.get_ref().position() as usize;
     check_sizes(&header, body).map_err(|m| err(None, m))?;
-    check_memory(&header, bytes.len()).map_err(|m| err(None, m))?;
 
     let vertex = header
         .elements
@@ -45,108 +42,30 @@ pub fn parse_ply(bytes: &[u8], path: &Path) -> Result<MeshDesc, MeshError> {
         .elements
         .get("face")
         .ok_or_else(|| err(None, "PLY file has no `face` element".into()))?;
-    let has = |names: &[&str]| names.iter().all(|n| vertex.properties.contains_key(*n));
-    if !has(&["x", "y", "z"]) {
+    if !["x", "y", "z"]
+        .iter()
+        .all(|n| vertex.properties.contains_key(*n))
+    {
         return Err(err(None, "PLY `vertex` element lacks x, y or z".into()));
     }
-    let index_name = ["vertex_indices", "vertex_index"]
-        .into_iter()
-        .find(|n| face.properties.contains_key(*n))
-        .ok_or_else(|| {
-            err(
-                None,
-                "PLY `face` element has no `vertex_indices` or `vertex_index` list".into(),
-            )
-        })?;
-    let normal_names = has(&["nx", "ny", "nz"]).then_some(["nx", "ny", "nz"]);
-    let uv_names = [
-        ["u", "v"],
-        ["s", "t"],
-        ["texture_u", "texture_v"],
-        ["texture_s", "texture_t"],
-    ]
-    .into_iter()
-    .find(|uv| has(uv));
-    let color_names = [["red", "green", "blue"], ["r", "g", "b"]]
-        .into_iter()
-        .find(|c| has(c));
-
-    let payload = parser.read_payload(&mut reader, &header).map_err(|e| {
-        let line = (header.encoding == Encoding::Ascii)
-            .then(|| e.line())
-            .flatten();
-        err(line, one_line(&e))
-    })?;
-    let vertices = &payload["vertex"];
-    let faces = &payload["face"];
-
-    let scalar = |el: &DefaultElement, name: &str| el.get(name).and_then(Property::to_f32_lossy);
-    let vec3 = |el: &DefaultElement, [a, b, c]: [&str; 3]| {
-        Some(Vec3::new(scalar(el, a)?, scalar(el, b)?, scalar(el, c)?))
-    };
-    let mut mesh = MeshDesc::default();
-    for (i, v) in vertices.iter().enumerate() {
-        let p = vec3(v, ["x", "y", "z"])
-            .ok_or_else(|| err(None, format!("vertex {i}: x, y, z must be numbers")))?;
-        mesh.positions.push(p);
-        if let Some(names) = normal_names {
-            let n = vec3(v, names)
-                .ok_or_else(|| err(None, format!("vertex {i}: nx, ny, nz must be numbers")))?;
-            mesh.normals.push(n);
-        }
-        if let Some([u, w]) = uv_names {
-            let uv = scalar(v, u).zip(scalar(v, w)).map(Vec2::from);
-            mesh.uvs
-                .push(uv.ok_or_else(|| err(None, format!("vertex {i}: uvs must be numbers")))?);
-        }
-        if let Some(names) = color_names {
-            let c = names.map(|n| v.get(n).and_then(color_channel));
-            let [Some(r), Some(g), Some(b)] = c else {
-                return Err(err(None, format!("vertex {i}: colours must be numbers")));
-            };
-            mesh.colors.push(Vec3::new(r, g, b));
-        }
+    if !["vertex_indices", "vertex_index"]
+        .iter()
+        .any(|n| face.properties.contains_key(*n))
+    {
+        return Err(err(
+            None,
+            "PLY `face` element has no `vertex_indices` or `vertex_index` list".into(),
+        ));
     }
-    let n = mesh.positions.len();
-    for (f, face) in faces.iter().enumerate() {
-        let ids = face
-            .get(index_name)
-            .and_then(Property::to_u32_list)
-            .ok_or_else(|| {
-                err(
-                    None,
-                    format!("face {f}: `{index_name}` must be a list of non-negative integers"),
-                )
-            })?;
-        if ids.len() < 3 {
-            return Err(err(None, format!("face {f} has {} vertices", ids.len())));
-        }
-        if let Some(i) = ids.iter().find(|&&i| i as usize >= n) {
-            return Err(err(
-                None,
-                format!("face {f}: vertex index {i} out of range ({n} vertices)"),
-            ));
-        }
-        mesh.indices
-            .extend((1..ids.len() - 1).map(|k| [ids[0], ids[k], ids[k + 1]]));
-    }
+
+    let start = bytes.len() - body;
+    let header_lines = bytes[..start].iter().filter(|&&b| b == b'\n').count();
+    let mesh = read_body(&header, &bytes[start..], header_lines)
+        .map_err(|(line, message)| err(line, message))?;
     if mesh.indices.is_empty() {
         return Err(err(None, "PLY file has no faces".into()));
     }
     Ok(mesh)
-}
-
-/// A vertex colour channel as linear light: 8- and 16-bit integers are sRGB-encoded, as
-/// scanners and Blender write them (so decoded, as Candela's image textures are), floats
-/// are taken as linear values.
-fn color_channel(p: &Property) -> Option<f32> {
-    let encoded = |v: f32, max: f32| srgb_decode((v / max).clamp(0.0, 1.0));
-    match p {
-        Property::UChar(v) => Some(encoded(f32::from(*v), 255.0)),
-        Property::UShort(v) => Some(encoded(f32::from(*v), 65535.0)),
-        Property::Float(_) | Property::Double(_) => p.to_f32_lossy().map(|v| v.max(0.0)),
-        _ => None,
-    }
 }
 
 /// The parser's message on one line, without its own "Line N: " prefix.
@@ -215,38 +134,10 @@ fn check_sizes(header: &Header, body: usize) -> Result<(), String> {
     Ok(())
 }
 
-/// Heap bytes one parsed property takes: `ply-rs` keeps each element's properties in a
-/// map keyed by name, 130–150 bytes a property as measured by `tests/limits.rs`, plus
-/// the mesh's own copy.
-const PARSED_BYTES_PER_PROPERTY: u128 = 160;
-
-/// Rejects a header whose elements would take more memory once parsed than the file's
-/// [`allocation_budget`](crate::limits::allocation_budget). Binary properties take at
-/// least a byte and ascii ones two, so only ascii files with most numbers a single digit
-/// (up to ~80× their size in memory) and of tens of megabytes can meet this.
-fn check_memory(header: &Header, file_len: usize) -> Result<(), String> {
-    let properties: u128 = header
-        .elements
-        .values()
-        .map(|e| e.count as u128 * e.properties.len() as u128)
-        .sum();
-    let need = properties * PARSED_BYTES_PER_PROPERTY;
-    let budget = crate::limits::allocation_budget(file_len);
-    if need > budget as u128 {
-        return Err(format!(
-            "PLY header declares {properties} properties, which would take about {} MiB \
-             to parse; a file of {file_len} bytes may use at most {} MiB (64 × its size + \
-             256 MiB)",
-            need >> 20,
-            budget >> 20
-        ));
-    }
-    Ok(())
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
+    use glam::{Vec2, Vec3};
 
     fn parse(bytes: &[u8]) -> Result<MeshDesc, MeshError> {
         parse_ply(bytes, Path::new("m.ply"))
@@ -415,5 +306,64 @@ mod tests {
         let e = parse(text.as_bytes()).unwrap_err();
         // The header takes 15 lines; the bad vertex is the third after it.
         assert_eq!(e.line, Some(18), "{e}");
+    }
+
+    /// Every prefix of an ascii file, and every byte of ascii and binary files changed
+    /// to a few values, gives a mesh or a one-line error, never a panic; a changed
+    /// byte in the binary body still gives a mesh of the same size or an error.
+    #[test]
+    fn truncated_and_flipped_files_are_meshes_or_errors() {
+        let ascii = ASCII_QUAD.as_bytes();
+        for len in 0..ascii.len() - 1 {
+            if let Err(e) = parse(&ascii[..len]) {
+                assert!(!e.message.contains('\n'), "{e:?}");
+            }
+        }
+        for file in [
+            ascii.to_vec(),
+            binary_triangle(false),
+            binary_triangle(true),
+        ] {
+            for at in 0..file.len() {
+                for x in [0x01u8, 0x20, 0x80, 0xff] {
+                    let mut bytes = file.clone();
+                    bytes[at] ^= x;
+                    match parse(&bytes) {
+                        Ok(mesh) => assert!(mesh.indices.len() <= 2, "byte {at} ^ {x:#x}"),
+                        Err(e) => assert!(!e.message.contains('\n'), "{e:?}"),
+                    }
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn binary_polygons_and_extra_elements_are_read_in_order() {
+        // A comment element before the vertices, an extra face property after the list.
+        let mut bytes = b"ply\nformat binary_big_endian 1.0\nelement note 2\nproperty short k\n\
+            element vertex 4\nproperty float x\nproperty uchar flag\nproperty float y\n\
+            property float z\nelement face 1\nproperty list uchar ushort vertex_indices\n\
+            property int tag\nend_header\n"
+            .to_vec();
+        bytes.extend([0, 1, 0, 2]);
+        for p in [
+            [0.0f32, 0.0, 0.0],
+            [1.0, 0.0, 0.0],
+            [1.0, 1.0, 0.0],
+            [0.0, 1.0, 0.5],
+        ] {
+            bytes.extend(p[0].to_be_bytes());
+            bytes.push(7);
+            bytes.extend(p[1].to_be_bytes());
+            bytes.extend(p[2].to_be_bytes());
+        }
+        bytes.push(4);
+        for i in [0u16, 1, 2, 3] {
+            bytes.extend(i.to_be_bytes());
+        }
+        bytes.extend(9i32.to_be_bytes());
+        let mesh = parse(&bytes).unwrap();
+        assert_eq!(mesh.positions[3], Vec3::new(0.0, 1.0, 0.5));
+        assert_eq!(mesh.indices, vec![[0, 1, 2], [0, 2, 3]]);
     }
 }

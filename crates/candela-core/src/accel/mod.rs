@@ -123,39 +123,58 @@ impl Accel {
         simd: Simd,
         layout: NodeLayout,
     ) -> Accel {
+        Accel::build_indexed(shapes.len(), |i| shapes[i as usize], filtered, simd, layout)
+    }
+
+    /// [`Accel::build_layout`] over `count` primitives that `shape(i)` gives, so that a
+    /// big scene need not hold an array of shapes beside its meshes while it builds.
+    pub fn build_indexed(
+        count: usize,
+        shape: impl Fn(u32) -> Shape,
+        filtered: impl Fn(u32) -> bool,
+        simd: Simd,
+        layout: NodeLayout,
+    ) -> Accel {
         assert!(
             simd.is_supported(),
             "{simd:?} kernels on a CPU without them"
         );
         assert!(
-            shapes.len() < ID_MASK as usize,
+            count < ID_MASK as usize,
             "at most 2^30 primitives per scene"
         );
-        let boxes: Vec<Aabb> = shapes.iter().map(Shape::bounds).collect();
-        let binary = Bvh::build_with(&boxes, SahCost::BLOCKS);
-        let record = |i: u32| match shapes[i as usize] {
+        let binary = Bvh::build_from(count, |i| shape(i as u32).bounds(), SahCost::BLOCKS);
+        let record = |i: u32| match shape(i) {
             Shape::Triangle(v) => (v, i | if filtered(i) { FILTERED } else { 0 }),
             Shape::Sphere { center, radius } => (
                 [center, Vec3::new(radius, 0.0, 0.0), Vec3::ZERO],
                 i | SPHERE,
             ),
         };
-        // One block per binary leaf; wide leaves then point at blocks, not prim ranges.
-        let mut block_of = vec![u32::MAX; binary.prims.len()];
-        let mut blocks = Vec::new();
-        for node in binary.nodes.iter().filter(|n| n.is_leaf()) {
-            let first = node.offset as usize;
-            let prims = &binary.prims[first..first + node.count as usize];
-            block_of[first] = blocks.len() as u32;
-            blocks.push(Block::new(
-                &prims.iter().map(|&i| record(i)).collect::<Vec<_>>(),
-            ));
-        }
+        // The wide tree first, so that the binary nodes are gone before the blocks take
+        // their memory; then one block per wide leaf lane, in the wide nodes' order, its
+        // lane pointing at the block rather than the primitive range.
         let mut bvh = WideBvh::collapse(&binary);
+        let prims = binary.prims;
+        drop(binary.nodes);
+        let leaves = bvh
+            .nodes
+            .iter()
+            .flat_map(|n| n.count)
+            .filter(|&c| c > 0)
+            .count();
+        let mut blocks = Vec::with_capacity(leaves);
+        let mut lanes = [([Vec3::ZERO; 3], 0u32); LANES];
         for node in &mut bvh.nodes {
             for lane in 0..node.child.len() {
-                if node.count[lane] > 0 {
-                    node.child[lane] = block_of[node.child[lane] as usize];
+                let count = node.count[lane] as usize;
+                if count > 0 {
+                    let first = node.child[lane] as usize;
+                    for (slot, &i) in lanes.iter_mut().zip(&prims[first..first + count]) {
+                        *slot = record(i);
+                    }
+                    node.child[lane] = blocks.len() as u32;
+                    blocks.push(Block::new(&lanes[..count]));
                 }
             }
         }

@@ -4,6 +4,7 @@
 //! reference the tests compare against.
 
 use glam::Vec3A;
+use rayon::prelude::*;
 
 use super::extents::{Box3A, Extents, PrimInfo};
 
@@ -106,16 +107,23 @@ impl Bvh {
 
     /// [`Bvh::build`] with the given cost model.
     pub fn build_with(boxes: &[Aabb], cost: SahCost) -> Bvh {
-        let mut infos: Vec<PrimInfo> = boxes
-            .iter()
-            .enumerate()
-            .filter(|(_, b)| !b.is_empty() && b.min.is_finite() && b.max.is_finite())
-            .map(|(i, b)| PrimInfo {
-                min: b.min.into(),
-                max: b.max.into(),
-                index: i as u32,
-            })
-            .collect();
+        Bvh::build_from(boxes.len(), |i| boxes[i], cost)
+    }
+
+    /// [`Bvh::build_with`] over `count` primitives whose boxes `box_of` gives, so that
+    /// no array of boxes need be kept beside the build's own.
+    pub fn build_from(count: usize, box_of: impl Fn(usize) -> Aabb, cost: SahCost) -> Bvh {
+        let mut infos = Vec::with_capacity(count);
+        infos.extend(
+            (0..count)
+                .map(|i| (i, box_of(i)))
+                .filter(|(_, b)| !b.is_empty() && b.min.is_finite() && b.max.is_finite())
+                .map(|(i, b)| PrimInfo {
+                    min: b.min.into(),
+                    max: b.max.into(),
+                    index: i as u32,
+                }),
+        );
         if infos.is_empty() {
             return Bvh::default();
         }
@@ -308,16 +316,7 @@ fn build_recursive(
         // Through i32: a plain truncating conversion (`as usize` checks for NaN).
         (((p.centroid2()[c0] - cmin_axis) * scale) as i32).clamp(0, last) as usize
     };
-    let mut bins = [Extents {
-        bounds: Box3A::EMPTY,
-        centroids: Box3A::EMPTY,
-    }; BINS];
-    let mut bin_counts = [0usize; BINS];
-    for p in prims.iter() {
-        let b = bin_of(p);
-        bin_counts[b] += 1;
-        bins[b].add(p);
-    }
+    let (bins, bin_counts) = bin_prims(prims, bin_of);
     let area = |b: &Box3A| b.aabb().surface_area();
     let mut right_area = [0.0f32; BINS];
     let mut right_count = [0usize; BINS];
@@ -370,6 +369,46 @@ fn build_recursive(
         depth,
         Some((left, right)),
         cost,
+    )
+}
+
+/// Nodes of more primitives than this are binned by both threads (or all), in chunks
+/// of a quarter of it: the top of the tree is where one thread would otherwise work
+/// alone on millions of primitives.
+const PARALLEL_BINNING: usize = 1 << 16;
+
+/// Each bin's extents and primitive count. Unions and counts do not depend on the
+/// order they are taken in, so the chunked parallel pass gives the serial one's bins
+/// exactly (and the same tree).
+fn bin_prims(
+    prims: &[PrimInfo],
+    bin_of: impl Fn(&PrimInfo) -> usize + Sync,
+) -> ([Extents; BINS], [usize; BINS]) {
+    const EMPTY: Extents = Extents {
+        bounds: Box3A::EMPTY,
+        centroids: Box3A::EMPTY,
+    };
+    let serial = |chunk: &[PrimInfo]| {
+        let (mut bins, mut counts) = ([EMPTY; BINS], [0usize; BINS]);
+        for p in chunk {
+            let b = bin_of(p);
+            counts[b] += 1;
+            bins[b].add(p);
+        }
+        (bins, counts)
+    };
+    if prims.len() <= PARALLEL_BINNING {
+        return serial(prims);
+    }
+    prims.par_chunks(PARALLEL_BINNING / 4).map(serial).reduce(
+        || ([EMPTY; BINS], [0; BINS]),
+        |(mut bins, mut counts), (b, c)| {
+            for i in 0..BINS {
+                bins[i].merge(&b[i]);
+                counts[i] += c[i];
+            }
+            (bins, counts)
+        },
     )
 }
 
