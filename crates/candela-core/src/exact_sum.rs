@@ -46,12 +46,6 @@ impl ExactSum {
         }
     }
 
-    /// Adds another sum; wrapping, so associative and commutative without exception.
-    #[inline]
-    pub fn add(self, other: ExactSum) -> ExactSum {
-        ExactSum(self.0.wrapping_add(other.0))
-    }
-
     /// The sum rounded to the nearest `f64`.
     #[inline]
     pub fn to_f64(self) -> f64 {
@@ -70,6 +64,23 @@ impl ExactSum {
     }
 }
 
+/// Wrapping addition, so associative and commutative without exception.
+impl std::ops::Add for ExactSum {
+    type Output = ExactSum;
+
+    #[inline]
+    fn add(self, other: ExactSum) -> ExactSum {
+        ExactSum(self.0.wrapping_add(other.0))
+    }
+}
+
+impl std::ops::AddAssign for ExactSum {
+    #[inline]
+    fn add_assign(&mut self, other: ExactSum) {
+        *self = *self + other;
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -83,19 +94,23 @@ mod tests {
         let f64_rev: f64 = xs.iter().rev().sum();
         assert_ne!(f64_fwd, f64_rev, "the example must defeat plain f64 sums");
         let exact = |it: &mut dyn Iterator<Item = &f64>| {
-            it.fold(ExactSum::ZERO, |s, &x| s.add(ExactSum::of(x).unwrap()))
+            it.fold(ExactSum::ZERO, |s, &x| s + ExactSum::of(x).unwrap())
         };
         let fwd = exact(&mut xs.iter());
         assert_eq!(fwd, exact(&mut xs.iter().rev()));
         let (a, b) = xs.split_at(3);
-        assert_eq!(fwd, exact(&mut b.iter()).add(exact(&mut a.iter())));
+        assert_eq!(fwd, exact(&mut b.iter()) + exact(&mut a.iter()));
     }
 
     #[test]
     fn contributions_round_once_to_the_resolution() {
         assert_eq!(ExactSum::of(1.0).unwrap().to_bits(), 1 << 56);
         assert_eq!(ExactSum::of(0.75 * RESOLUTION).unwrap().to_bits(), 1);
-        assert_eq!(ExactSum::of(0.5 * RESOLUTION).unwrap().to_bits(), 0, "ties to even");
+        assert_eq!(
+            ExactSum::of(0.5 * RESOLUTION).unwrap().to_bits(),
+            0,
+            "ties to even"
+        );
         assert_eq!(ExactSum::of(-2.5).unwrap().to_f64(), -2.5);
         // A product of two f32 (48 significant bits) above 2⁻⁸ survives exactly.
         let x = 1.1f32 as f64 * 0.3f32 as f64;

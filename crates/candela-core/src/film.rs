@@ -44,9 +44,9 @@ impl Pixel {
         match terms {
             [Some(r), Some(g), Some(b), Some(w)] => {
                 for (sum, t) in self.radiance_sum.iter_mut().zip([r, g, b]) {
-                    *sum = sum.add(t);
+                    *sum += t;
                 }
-                self.weight_sum = self.weight_sum.add(w);
+                self.weight_sum += w;
             }
             _ => self.rejected += 1,
         }
@@ -56,9 +56,9 @@ impl Pixel {
     #[inline]
     pub fn merge(&mut self, other: &Pixel) {
         for (a, b) in self.radiance_sum.iter_mut().zip(other.radiance_sum) {
-            *a = a.add(b);
+            *a += b;
         }
-        self.weight_sum = self.weight_sum.add(other.weight_sum);
+        self.weight_sum += other.weight_sum;
         self.samples += other.samples;
         self.rejected += other.rejected;
     }
