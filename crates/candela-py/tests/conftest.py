@@ -8,40 +8,10 @@ import pytest
 
 REPO = Path(__file__).resolve().parents[3]
 
-# A floor, an emitting sphere and a point light (the CLI tests' scene), 24x16.
-SCENE = """
-[render]
-resolution = [24, 16]
-spp = 8
-max_depth = 3
-
-[camera]
-type = "pinhole"
-position = [0, 1, 4]
-look_at = [0, 1, 0]
-fov = 45
-
-[materials.white]
-type = "diffuse"
-albedo = 0.7
-
-[[shape]]
-type = "rectangle"
-material = "white"
-transform = [{ rotate = { axis = [1, 0, 0], angle = -90 } }, { scale = 3 }]
-
-[[shape]]
-type = "sphere"
-center = [0, 1, 0]
-radius = 0.5
-material = "white"
-emission = [4, 3, 2]
-
-[[light]]
-type = "point"
-position = [1, 3, 1]
-intensity = 5
-"""
+# A floor, an emitting sphere and a point light, 24x16: the CLI tests' scene, read from
+# their source so that the two suites render the same thing.
+_COMMON = (REPO / "crates/candela-cli/tests/common/mod.rs").read_text()
+SCENE = _COMMON.split('pub const SCENE: &str = r#"', 1)[1].split('"#;', 1)[0]
 
 
 @pytest.fixture

@@ -66,11 +66,12 @@ def test_a_killed_worker_is_retried_and_the_result_is_still_exact(local_ray, sce
     assert np.array_equal(result["film"].image().view(np.uint32), whole.view(np.uint32))
 
 
-def test_the_command_line_entry_point(scene_path, tmp_path):
+def test_the_command_line_entry_point_shipping_the_scene(scene_path, tmp_path):
+    """`--ship` uploads the scene's folder as the job's working_dir (no shared paths)."""
     out = tmp_path / "out.exr"
     p = subprocess.run(
         [sys.executable, "-m", "candela.distributed", str(scene_path), "--spp", "8",
-         "--chunks", "4", "--workers", "2", "-o", str(out)],
+         "--chunks", "4", "--workers", "2", "--ship", "-o", str(out)],
         capture_output=True, text=True, timeout=300,
     )
     assert p.returncode == 0, p.stderr
