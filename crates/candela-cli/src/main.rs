@@ -9,10 +9,10 @@ mod footprint;
 mod ies;
 mod info;
 mod layers;
-mod output;
 mod passes;
 mod render;
-mod tonemap;
+
+use candela_cli::{merge, output, part, tonemap, UserError};
 
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -46,15 +46,26 @@ enum Command {
         #[arg(long)]
         plot: Option<PathBuf>,
     },
+    /// Merge film parts (renders of disjoint --samples ranges of one scene) into one
+    /// image, bit for bit the render of their union.
+    Merge(MergeArgs),
 }
 
-/// A user-facing failure: printed as one line, exit code 2.
-#[derive(Debug)]
-pub struct UserError(pub String);
+#[derive(clap::Args)]
+struct MergeArgs {
+    /// Part files (.exr written by `render --samples` or by `merge`).
+    #[arg(required = true)]
+    parts: Vec<PathBuf>,
+    /// Output: .exr (a part holding the union, mergeable again), .pfm or .png.
+    #[arg(short, long)]
+    output: PathBuf,
+    #[command(flatten)]
+    display: render::DisplayArgs,
+}
 
-impl<E: std::fmt::Display> From<E> for UserError {
-    fn from(e: E) -> Self {
-        UserError(e.to_string())
+impl MergeArgs {
+    fn run(&self) -> Result<(), UserError> {
+        merge::run(&self.parts, &self.output, &self.display.transform())
     }
 }
 
@@ -73,6 +84,7 @@ fn main() -> ExitCode {
     let result = match cli.command {
         Command::Render(args) => render::run(args),
         Command::Info { scene, load } => info::run(&scene, &load).map(|()| ExitCode::SUCCESS),
+        Command::Merge(args) => args.run().map(|()| ExitCode::SUCCESS),
         Command::Ies { file, plot } => ies::run(&file, plot.as_deref()).map(|()| ExitCode::SUCCESS),
     };
     match result {

@@ -42,6 +42,11 @@ pub struct PassArgs {
 }
 
 impl PassArgs {
+    /// Whether `--aov` or `--denoise` was given.
+    pub fn requested(&self) -> bool {
+        self.aov.is_some() || self.denoise.is_some()
+    }
+
     /// `--aov` over the scene's own `aov` list.
     pub fn apply(&self, r: &mut RenderSettings) {
         if let Some(set) = self.aov {

@@ -21,6 +21,7 @@ use signal_hook::consts::{SIGINT, SIGTERM};
 use signal_hook::flag;
 
 use crate::output::ImageFormat;
+use crate::part::{write_part, PartInfo};
 use crate::tonemap::{DisplayTransform, Tonemap};
 use crate::UserError;
 
@@ -95,15 +96,12 @@ pub struct RenderArgs {
     /// Resolution as WIDTHxHEIGHT.
     #[arg(long, value_parser = parse_resolution)]
     res: Option<(u32, u32)>,
-    /// Exposure in stops, applied before PNG encoding.
-    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
-    exposure: f32,
-    /// Tone curve applied before PNG encoding (EXR/PFM stay linear).
-    #[arg(long, value_enum, default_value_t = Tonemap::None)]
-    tonemap: Tonemap,
-    /// Encode PNG with a pure power law 1/γ instead of the sRGB curve, e.g. 2.2.
-    #[arg(long, value_parser = parse_gamma)]
-    gamma: Option<f32>,
+    #[command(flatten)]
+    display: DisplayArgs,
+    /// Render only these sample indices of every pixel (START..END, within 0..spp) and
+    /// write an .exr film part that `candela merge` combines exactly with other parts.
+    #[arg(long, value_name = "START..END", value_parser = crate::part::parse_range)]
+    samples: Option<std::ops::Range<u32>>,
     /// MIS heuristic between light and BSDF sampling: balance, power, none (light
     /// sampling only) or bsdf (BSDF sampling only).
     #[arg(long, value_parser = parse_name::<MisMode>)]
@@ -138,6 +136,30 @@ pub struct RenderArgs {
     f_number: Option<f32>,
     #[command(flatten)]
     passes: crate::passes::PassArgs,
+}
+
+/// How a linear image becomes PNG pixels.
+#[derive(Args)]
+pub struct DisplayArgs {
+    /// Exposure in stops, applied before PNG encoding.
+    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
+    exposure: f32,
+    /// Tone curve applied before PNG encoding (EXR/PFM stay linear).
+    #[arg(long, value_enum, default_value_t = Tonemap::None)]
+    tonemap: Tonemap,
+    /// Encode PNG with a pure power law 1/γ instead of the sRGB curve, e.g. 2.2.
+    #[arg(long, value_parser = parse_gamma)]
+    gamma: Option<f32>,
+}
+
+impl DisplayArgs {
+    pub fn transform(&self) -> DisplayTransform {
+        DisplayTransform {
+            exposure: self.exposure,
+            tonemap: self.tonemap,
+            gamma: self.gamma,
+        }
+    }
 }
 
 /// Parses a setting's name as scene files spell it, so the two cannot drift apart.
@@ -264,9 +286,39 @@ impl Interrupt {
     }
 }
 
+/// What a `--samples` part holds; the range must lie within the render's spp.
+fn part_info(desc: &SceneDesc, range: &std::ops::Range<u32>) -> Result<PartInfo, UserError> {
+    let spp = desc.render.spp;
+    if range.end > spp {
+        return Err(UserError(format!(
+            "--samples {}..{} lies beyond the render's {spp} spp (--spp sets the whole render's count)",
+            range.start, range.end
+        )));
+    }
+    Ok(PartInfo {
+        fingerprint: candela_core::fingerprint::fingerprint(desc),
+        seed: desc.render.seed,
+        spp,
+        samples: vec![range.clone()],
+    })
+}
+
 pub fn run(args: RenderArgs) -> Result<ExitCode, UserError> {
     // Fail on a bad output name before spending any time rendering.
-    ImageFormat::from_path(&args.output)?;
+    let format = ImageFormat::from_path(&args.output)?;
+    if args.samples.is_some() && format != ImageFormat::Exr {
+        return Err(UserError(format!(
+            "{}: --samples writes a film part, which needs an .exr output",
+            args.output.display()
+        )));
+    }
+    if args.samples.is_some() && args.passes.requested() {
+        return Err(UserError(
+            "--aov and --denoise apply to a whole render, not to a --samples part \
+             (merge the parts first)"
+                .into(),
+        ));
+    }
     let loaded = Instant::now();
     let mut desc = args.load.load(&args.scene)?;
     let load_s = loaded.elapsed().as_secs_f64();
@@ -279,6 +331,11 @@ pub fn run(args: RenderArgs) -> Result<ExitCode, UserError> {
     }
     args.apply_environment(&mut desc)?;
     let denoiser = args.passes.load_denoiser()?;
+    let part = args
+        .samples
+        .as_ref()
+        .map(|r| part_info(&desc, r))
+        .transpose()?;
     let built = Instant::now();
     let scene = candela_core::build::build_owned(desc)?;
     let build_s = built.elapsed().as_secs_f64();
@@ -291,7 +348,8 @@ pub fn run(args: RenderArgs) -> Result<ExitCode, UserError> {
         .map_err(|e| UserError(format!("cannot start {threads} threads: {e}")))?;
     let interrupt = Interrupt::install()?;
 
-    let total = s.width as u64 * s.height as u64 * s.spp as u64;
+    let range = args.samples.clone().unwrap_or(0..s.spp);
+    let total = s.width as u64 * s.height as u64 * range.len() as u64;
     let bar = ProgressBar::new(total);
     bar.set_style(
         ProgressStyle::with_template(
@@ -300,23 +358,28 @@ pub fn run(args: RenderArgs) -> Result<ExitCode, UserError> {
         .expect("valid progress template"),
     );
     let start = Instant::now();
-    let result =
-        pool.install(|| integrator::render(&scene, 0..s.spp, &interrupt.cancel, &|n| bar.inc(n)));
+    let result = pool
+        .install(|| integrator::render(&scene, range.clone(), &interrupt.cancel, &|n| bar.inc(n)));
     let elapsed = start.elapsed().as_secs_f64();
     bar.finish_and_clear();
 
-    let pixels = result.film.resolve();
-    let display = DisplayTransform {
-        exposure: args.exposure,
-        tonemap: args.tonemap,
-        gamma: args.gamma,
-    };
-    let passes = pool.install(|| {
-        let (d, cancel) = (denoiser.as_ref(), &interrupt.cancel);
-        crate::passes::finish(&args.passes, d, &scene, pixels, cancel, threads)
-    })?;
-    let passes_summary = passes.summary.clone();
-    passes.write(&args.output, &display)?;
+    let mut passes_summary = None;
+    match &part {
+        Some(info) if !result.cancelled => write_part(&args.output, &result.film, info)?,
+        Some(_) => {
+            eprintln!("candela: interrupted: no part written (a part holds its whole range)");
+            return Ok(interrupt.exit_code());
+        }
+        None => {
+            let pixels = result.film.resolve();
+            let passes = pool.install(|| {
+                let (d, cancel) = (denoiser.as_ref(), &interrupt.cancel);
+                crate::passes::finish(&args.passes, d, &scene, pixels, cancel, threads)
+            })?;
+            passes_summary = passes.summary.clone();
+            passes.write(&args.output, &args.display.transform())?;
+        }
+    }
 
     let st = result.stats;
     println!(

@@ -73,7 +73,7 @@ fn check_color(span: &Span, what: &str, c: Vec3) -> Result<(), BuildError> {
     Ok(())
 }
 
-/// The most pixels an image may have: 2²⁶ (8192 × 8192), whose film takes 2.7 GB. A
+/// The most pixels an image may have: 2²⁶ (8192 × 8192), whose film takes 4.8 GB. A
 /// resolution is two numbers in a small file, so without a cap a scene of a hundred bytes
 /// could ask for terabytes.
 pub const MAX_PIXELS: u64 = 1 << 26;

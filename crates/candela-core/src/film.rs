@@ -2,15 +2,24 @@
 //! count, so it can be resolved into an image at any moment. Films of disjoint sample
 //! ranges of one image add up to the film of their union ([`Film::merge`]): that is how a
 //! render is split across processes or machines.
+//!
+//! The sums are [`ExactSum`]s, fixed-point integers (see [`crate::exact_sum`] for their
+//! range and resolution), so that the merge of any split of a sample range is the film
+//! of the whole range **bit for bit**, whatever the grouping and order of the parts. The
+//! same holds for any other way contributions reach a pixel: [`Pixel::add`] is "add this
+//! weighted contribution to this pixel", and a renderer that splats a sample into
+//! neighbouring pixels from several threads gets the same film in every run.
 
-use glam::{DVec3, Vec3};
+use glam::Vec3;
 
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
+use crate::exact_sum::ExactSum;
+
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct Pixel {
-    /// Σ wᵢ·Lᵢ over accepted samples.
-    pub radiance_sum: DVec3,
+    /// Σ wᵢ·Lᵢ over accepted samples, per channel.
+    pub radiance_sum: [ExactSum; 3],
     /// Σ wᵢ.
-    pub weight_sum: f64,
+    pub weight_sum: ExactSum,
     /// Samples taken, accepted or not.
     pub samples: u32,
     /// Samples dropped because they were not finite.
@@ -18,30 +27,55 @@ pub struct Pixel {
 }
 
 impl Pixel {
-    /// Adds a sample with filter weight `weight`. A sample with a NaN or infinite value is
-    /// counted and dropped, so it never reaches the image.
+    /// Adds a sample with filter weight `weight`. A sample with a NaN or infinite value,
+    /// or one beyond [`crate::exact_sum::MAX_CONTRIBUTION`], is counted and dropped, so
+    /// it never reaches the image.
     #[inline]
     pub fn add(&mut self, radiance: Vec3, weight: f32) {
         self.samples += 1;
-        if !radiance.is_finite() || !weight.is_finite() {
-            self.rejected += 1;
-            return;
+        // f32 × f32 is exact in f64: the one rounding is ExactSum's, per contribution.
+        let w = weight as f64;
+        let terms = [
+            ExactSum::of(radiance.x as f64 * w),
+            ExactSum::of(radiance.y as f64 * w),
+            ExactSum::of(radiance.z as f64 * w),
+            ExactSum::of(w),
+        ];
+        match terms {
+            [Some(r), Some(g), Some(b), Some(w)] => {
+                for (sum, t) in self.radiance_sum.iter_mut().zip([r, g, b]) {
+                    *sum += t;
+                }
+                self.weight_sum += w;
+            }
+            _ => self.rejected += 1,
         }
-        self.radiance_sum += radiance.as_dvec3() * weight as f64;
-        self.weight_sum += weight as f64;
+    }
+
+    /// Adds another pixel's sums and counts (a disjoint set of samples).
+    #[inline]
+    pub fn merge(&mut self, other: &Pixel) {
+        for (a, b) in self.radiance_sum.iter_mut().zip(other.radiance_sum) {
+            *a += b;
+        }
+        self.weight_sum += other.weight_sum;
+        self.samples += other.samples;
+        self.rejected += other.rejected;
     }
 
     /// The pixel's estimate: the weighted mean of its samples (black if none).
     pub fn value(&self) -> Vec3 {
-        if self.weight_sum > 0.0 {
-            (self.radiance_sum / self.weight_sum).as_vec3()
+        let w = self.weight_sum.to_f64();
+        if w > 0.0 {
+            let [r, g, b] = self.radiance_sum.map(|s| (s.to_f64() / w) as f32);
+            Vec3::new(r, g, b)
         } else {
             Vec3::ZERO
         }
     }
 }
 
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, Eq)]
 pub struct Film {
     pub width: u32,
     pub height: u32,
@@ -62,6 +96,13 @@ impl Film {
         &self.pixels[(y * self.width + x) as usize]
     }
 
+    /// Adds a contribution with filter weight `weight` to pixel (`x`, `y`): a sample of
+    /// its own or one splatted from a neighbour. The film does not depend on the order of
+    /// the additions.
+    pub fn add(&mut self, x: u32, y: u32, radiance: Vec3, weight: f32) {
+        self.pixels[(y * self.width + x) as usize].add(radiance, weight);
+    }
+
     /// The image: each pixel divided by its own weights, so a film interrupted part-way
     /// still resolves to an unbiased (noisier) image.
     pub fn resolve(&self) -> Vec<Vec3> {
@@ -76,10 +117,7 @@ impl Film {
             "films differ in size"
         );
         for (a, b) in self.pixels.iter_mut().zip(&other.pixels) {
-            a.radiance_sum += b.radiance_sum;
-            a.weight_sum += b.weight_sum;
-            a.samples += b.samples;
-            a.rejected += b.rejected;
+            a.merge(b);
         }
     }
 
@@ -117,5 +155,38 @@ mod tests {
         }
         a.merge(&b);
         assert_eq!(a, whole);
+    }
+
+    /// Values whose f64 sums depend on the order: the film's do not.
+    #[test]
+    fn merges_in_any_grouping_and_order_are_the_same_bits() {
+        let values: Vec<f32> = (0..64)
+            .map(|i| {
+                let i = i as f32;
+                (i * 0.731).sin().abs() * 10f32.powi((i as i32 % 13) - 6)
+            })
+            .collect();
+        let film_of = |range: std::ops::Range<usize>| {
+            let mut f = Film::new(1, 1);
+            for &v in &values[range] {
+                f.add(0, 0, Vec3::new(v, 0.5 * v, 3.0 * v), 0.75);
+            }
+            f
+        };
+        let whole = film_of(0..64);
+        for cuts in [vec![32], vec![1], vec![5, 17, 40, 63], (1..64).collect()] {
+            let mut bounds = vec![0];
+            bounds.extend(&cuts);
+            bounds.push(64);
+            let parts: Vec<Film> = bounds.windows(2).map(|b| film_of(b[0]..b[1])).collect();
+            let mut merged = Film::new(1, 1);
+            for part in parts.iter().rev() {
+                merged.merge(part);
+            }
+            assert_eq!(merged, whole, "split at {cuts:?}");
+        }
+        let sequential: f64 = values.iter().map(|&v| v as f64 * 0.75).sum();
+        let reversed: f64 = values.iter().rev().map(|&v| v as f64 * 0.75).sum();
+        assert_ne!(sequential, reversed, "the data must defeat plain f64 sums");
     }
 }

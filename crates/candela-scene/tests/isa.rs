@@ -19,7 +19,7 @@ fn root() -> PathBuf {
 
 /// Every pixel's sums and counts, as bits, and the ray count, of `file` rendered at
 /// 40×30 with 4 spp by the copy `isa`.
-fn film_bits(file: &str, isa: Isa) -> (Vec<u64>, u64) {
+fn film_bits(file: &str, isa: Isa) -> (Vec<i128>, u64) {
     let mut desc = candela_scene::load_scene(&root().join("scenes").join(file)).unwrap();
     desc.render.width = 40;
     desc.render.height = 30;
@@ -32,7 +32,7 @@ fn film_bits(file: &str, isa: Isa) -> (Vec<u64>, u64) {
         .pixels
         .iter()
         .flat_map(|p| {
-            let [r, g, b] = p.radiance_sum.to_array().map(f64::to_bits);
+            let [r, g, b] = p.radiance_sum.map(|s| s.to_bits());
             [
                 r,
                 g,
