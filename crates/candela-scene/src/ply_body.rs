@@ -154,8 +154,11 @@ impl Numbers for Binary<'_> {
     }
 }
 
+/// The body's lines, numbered from 0.
+type Lines<'a> = std::iter::Enumerate<std::slice::Split<'a, u8, fn(&u8) -> bool>>;
+
 struct Ascii<'a> {
-    lines: std::iter::Enumerate<std::slice::Split<'a, u8, fn(&u8) -> bool>>,
+    lines: Lines<'a>,
     tokens: std::str::SplitAsciiWhitespace<'a>,
     /// Lines before the body (the header's).
     first_line: usize,
@@ -262,17 +265,15 @@ fn read_elements(header: &Header, numbers: &mut impl Numbers) -> Result<MeshDesc
             let mut position = Vec3::ZERO;
             let (mut normal, mut uv, mut color) = (Vec3::ZERO, Vec2::ZERO, Vec3::ZERO);
             for (slot, ty) in slots.iter().zip(&types) {
-                let result = read_property(numbers, ty, *slot, &mut fan).and_then(|x| {
-                    match (*slot, x) {
-                        (Slot::Position(k), Some(v)) => position[k] = v,
-                        (Slot::Normal(k), Some(v)) => normal[k] = v,
-                        (Slot::Uv(k), Some(v)) => uv[k] = v,
-                        (Slot::Color(k), Some(v)) => color[k] = v,
-                        _ => {}
-                    }
-                    Ok(())
-                });
-                result.map_err(|m| located(m, &*numbers))?;
+                let value = read_property(numbers, ty, *slot, &mut fan)
+                    .map_err(|m| located(m, &*numbers))?;
+                match (*slot, value) {
+                    (Slot::Position(k), Some(v)) => position[k] = v,
+                    (Slot::Normal(k), Some(v)) => normal[k] = v,
+                    (Slot::Uv(k), Some(v)) => uv[k] = v,
+                    (Slot::Color(k), Some(v)) => color[k] = v,
+                    _ => {}
+                }
             }
             match element.name.as_str() {
                 "vertex" => {
