@@ -31,6 +31,31 @@ impl Pixel {
         self.weight_sum += weight as f64;
     }
 
+    /// Counts a sample taken in this pixel whose radiance other calls share out (see
+    /// [`crate::splat`]); returns whether it is finite, else it is counted as dropped.
+    #[inline]
+    pub fn count(&mut self, radiance: Vec3) -> bool {
+        self.samples += 1;
+        let finite = radiance.is_finite();
+        self.rejected += !finite as u32;
+        finite
+    }
+
+    /// Adds a share `weight` of a sample counted elsewhere ([`Self::count`]).
+    #[inline]
+    pub fn add_weighted(&mut self, radiance: Vec3, weight: f32) {
+        self.radiance_sum += radiance.as_dvec3() * weight as f64;
+        self.weight_sum += weight as f64;
+    }
+
+    /// Adds another accumulator of the same pixel (disjoint samples) into this one.
+    pub fn merge(&mut self, other: &Pixel) {
+        self.radiance_sum += other.radiance_sum;
+        self.weight_sum += other.weight_sum;
+        self.samples += other.samples;
+        self.rejected += other.rejected;
+    }
+
     /// The pixel's estimate: the weighted mean of its samples (black if none).
     pub fn value(&self) -> Vec3 {
         if self.weight_sum > 0.0 {
@@ -76,10 +101,7 @@ impl Film {
             "films differ in size"
         );
         for (a, b) in self.pixels.iter_mut().zip(&other.pixels) {
-            a.radiance_sum += b.radiance_sum;
-            a.weight_sum += b.weight_sum;
-            a.samples += b.samples;
-            a.rejected += b.rejected;
+            a.merge(b);
         }
     }
 

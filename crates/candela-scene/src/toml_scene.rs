@@ -11,8 +11,8 @@
 use std::path::Path;
 
 use candela_core::desc::{
-    BsdfDesc, EmissionProfileDesc, LampSampling, LightSamplerKind, MaterialDesc, MisMode,
-    RenderSettings, SamplerKind, SceneDesc,
+    BsdfDesc, EmissionProfileDesc, FilterSampling, LampSampling, LightSamplerKind, MaterialDesc,
+    MisMode, RenderSettings, SamplerKind, SceneDesc,
 };
 use serde::de::DeserializeOwned;
 use serde::Deserialize;
@@ -183,6 +183,7 @@ struct RenderSection {
     lamp_sampling: Option<LampSampling>,
     ris_candidates: Option<std::num::NonZeroU32>,
     sampler: Option<SamplerKind>,
+    filter_sampling: Option<FilterSampling>,
 }
 
 fn parse_render(src: &Source, value: Item) -> Result<RenderSettings, LoadError> {
@@ -204,6 +205,7 @@ fn parse_render(src: &Source, value: Item) -> Result<RenderSettings, LoadError> 
         out.ris_candidates = n.get();
     }
     out.sampler = r.sampler.unwrap_or(out.sampler);
+    out.filter_sampling = r.filter_sampling.unwrap_or(out.filter_sampling);
     Ok(out)
 }
 
