@@ -108,7 +108,8 @@ pub struct RenderArgs {
     /// sampling only) or bsdf (BSDF sampling only).
     #[arg(long, value_parser = parse_name::<MisMode>)]
     mis: Option<MisMode>,
-    /// How next event estimation picks a light: uniform, power, array, ris, bvh or ris-bvh.
+    /// How next event estimation picks a light: uniform, power, array, ris, bvh (the
+    /// default) or ris-bvh.
     #[arg(long, value_parser = parse_name::<LightSamplerKind>)]
     light_sampler: Option<LightSamplerKind>,
     /// How next event estimation draws points on flat lamps: area (uniformly by area, the

@@ -586,13 +586,16 @@ pub enum MisMode {
 pub enum LightSamplerKind {
     Uniform,
     /// Proportional to emitted power, through an alias table.
-    #[default]
     Power,
     /// Proportional to power through the course notes' slot array.
     Array,
     /// Resampled importance sampling over candidates from the array.
     Ris,
-    /// Light BVH with orientation cones (Conty Estevez & Kulla 2018).
+    /// Light BVH with orientation cones (Conty Estevez & Kulla 2018): the default, since
+    /// at equal spp it measured 0.26–0.72× `Power`'s relMSE where the choice of light
+    /// matters, 0.86× on glossy plates and the same with one light, for 1.0–1.8× the CPU
+    /// time per sample (`bench/equal_spp.sh`, bench/RESULTS.md, issue 36).
+    #[default]
     Bvh,
     /// Resampled importance sampling over candidates from the light BVH.
     RisBvh,

@@ -140,7 +140,9 @@ impl ImportanceBounds {
         let cos_x = cos_sub_clamped(sin_w, cos_w, self.sin_theta_o, self.cos_theta_o);
         let sin_x = sin_sub_clamped(sin_w, cos_w, self.sin_theta_o, self.cos_theta_o);
         let cos_p = cos_sub_clamped(sin_x, cos_x, sin_b, cos_b);
-        if cos_p <= self.cos_theta_e {
+        // Strictly beyond θ_e only: a light with θ_e = 0 (a projector's or a hard-edged
+        // spot's cone, emission exactly within θ_o) gives cos θ' = 1 inside its cone.
+        if cos_p < self.cos_theta_e {
             return 0.0;
         }
         let mut importance = self.intensity * cos_p / d2c;
