@@ -11,8 +11,8 @@ use std::sync::Arc;
 use std::time::Instant;
 
 use candela_core::desc::{
-    ApertureSizeDesc, EnvironmentDesc, EnvironmentMapDesc, FocusDesc, Isa, LampSampling, LensDesc,
-    LightSamplerKind, MisMode, SamplerKind, SceneDesc, Span,
+    ApertureSizeDesc, EnvironmentDesc, EnvironmentMapDesc, FilterSampling, FocusDesc, Isa,
+    LampSampling, LensDesc, LightSamplerKind, MisMode, SamplerKind, SceneDesc, Span,
 };
 use candela_core::integrator;
 use clap::Args;
@@ -106,7 +106,8 @@ pub struct RenderArgs {
     /// sampling only) or bsdf (BSDF sampling only).
     #[arg(long, value_parser = parse_name::<MisMode>)]
     mis: Option<MisMode>,
-    /// How next event estimation picks a light: uniform, power, array, ris, bvh or ris-bvh.
+    /// How next event estimation picks a light: uniform, power, array, ris, bvh (the
+    /// default) or ris-bvh.
     #[arg(long, value_parser = parse_name::<LightSamplerKind>)]
     light_sampler: Option<LightSamplerKind>,
     /// How next event estimation draws points on flat lamps: area (uniformly by area, the
@@ -121,6 +122,12 @@ pub struct RenderArgs {
     /// the first bounce's BSDF direction from a correlated multi-jittered pattern).
     #[arg(long, value_parser = parse_name::<SamplerKind>)]
     sampler: Option<SamplerKind>,
+    /// How a pixel filter wider than a pixel (a Mitsuba scene's tent or Gaussian) reaches
+    /// the image: splat (the default: each sample weighted into every pixel under the
+    /// filter, as Mitsuba) or importance (each sample's offset drawn from the filter, into
+    /// its own pixel).
+    #[arg(long, value_parser = parse_name::<FilterSampling>)]
+    filter_sampling: Option<FilterSampling>,
     /// Which compiled copy of the render loop runs: auto (the fastest the CPU has),
     /// baseline (any x86-64) or v3 (x86-64-v3: AVX2, FMA, BMI2). Same pixels with each.
     #[arg(long, value_parser = parse_name::<Isa>)]
@@ -211,6 +218,7 @@ impl RenderArgs {
             r.ris_candidates = n;
         }
         r.sampler = self.sampler.unwrap_or(r.sampler);
+        r.filter_sampling = self.filter_sampling.unwrap_or(r.filter_sampling);
         r.isa = self.isa.unwrap_or(r.isa);
         self.passes.apply(r);
         if self.focus_distance.is_some() || self.f_number.is_some() {

@@ -604,13 +604,16 @@ pub enum MisMode {
 pub enum LightSamplerKind {
     Uniform,
     /// Proportional to emitted power, through an alias table.
-    #[default]
     Power,
     /// Proportional to power through the course notes' slot array.
     Array,
     /// Resampled importance sampling over candidates from the array.
     Ris,
-    /// Light BVH with orientation cones (Conty Estevez & Kulla 2018).
+    /// Light BVH with orientation cones (Conty Estevez & Kulla 2018): the default, since
+    /// at equal spp it measured 0.26–0.72× `Power`'s relMSE where the choice of light
+    /// matters, 0.86× on glossy plates and the same with one light, for 1.0–1.8× the CPU
+    /// time per sample (`bench/equal_spp.sh`, bench/RESULTS.md, issue 36).
+    #[default]
     Bvh,
     /// Resampled importance sampling over candidates from the light BVH.
     RisBvh,
@@ -706,6 +709,8 @@ pub struct RenderSettings {
     /// all, as with Mitsuba's `hide_emitters` (the emitters still light the scene).
     pub hide_emitters: bool,
     pub filter: PixelFilterDesc,
+    /// How samples reach the pixels under a filter wider than a pixel.
+    pub filter_sampling: FilterSampling,
     /// Which compiled copy of the render loop runs; it must be supported by the CPU
     /// ([`Isa::is_supported`]).
     pub isa: Isa,
@@ -729,6 +734,24 @@ pub enum PixelFilterDesc {
     },
 }
 
+/// How a pixel filter wider than a pixel (tent, Gaussian) reaches the image (see
+/// [`crate::splat`]). Its names in scene files and on the command line are `splat` and
+/// `importance`. The box filter renders the same either way.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum FilterSampling {
+    /// Each sample, uniform in its pixel, adds to every pixel under the filter, weighted by
+    /// it; each pixel divides by its weights' sum (Mitsuba's way). A pixel then averages
+    /// about as many samples as the filter covers pixels, so at equal spp its noise is
+    /// lower: the default.
+    #[default]
+    Splat,
+    /// Each sample's offset is drawn from the filter and the sample goes to its own pixel
+    /// only (filter importance sampling, Ernst et al. 2006): the same expected image, with
+    /// no sample crossing a pixel.
+    Importance,
+}
+
 impl Default for RenderSettings {
     fn default() -> Self {
         RenderSettings {
@@ -745,6 +768,7 @@ impl Default for RenderSettings {
             sampler: SamplerKind::default(),
             hide_emitters: false,
             filter: PixelFilterDesc::Box,
+            filter_sampling: FilterSampling::default(),
             isa: Isa::Auto,
             aovs: crate::aov::AovSet::NONE,
         }

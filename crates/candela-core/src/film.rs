@@ -33,22 +33,8 @@ impl Pixel {
     #[inline]
     pub fn add(&mut self, radiance: Vec3, weight: f32) {
         self.samples += 1;
-        // f32 × f32 is exact in f64: the one rounding is ExactSum's, per contribution.
-        let w = weight as f64;
-        let terms = [
-            ExactSum::of(radiance.x as f64 * w),
-            ExactSum::of(radiance.y as f64 * w),
-            ExactSum::of(radiance.z as f64 * w),
-            ExactSum::of(w),
-        ];
-        match terms {
-            [Some(r), Some(g), Some(b), Some(w)] => {
-                for (sum, t) in self.radiance_sum.iter_mut().zip([r, g, b]) {
-                    *sum += t;
-                }
-                self.weight_sum += w;
-            }
-            _ => self.rejected += 1,
+        if !self.add_weighted(radiance, weight) {
+            self.rejected += 1;
         }
     }
 
@@ -61,6 +47,45 @@ impl Pixel {
         self.weight_sum += other.weight_sum;
         self.samples += other.samples;
         self.rejected += other.rejected;
+    }
+
+    /// Counts a sample taken in this pixel whose radiance other calls share out (see
+    /// [`crate::splat`]); returns whether it is accepted: finite and within
+    /// [`crate::exact_sum::MAX_CONTRIBUTION`], as [`Self::add`] accepts a sample, else it
+    /// is counted as dropped.
+    #[inline]
+    pub fn count(&mut self, radiance: Vec3) -> bool {
+        self.samples += 1;
+        let accepted = radiance.is_finite()
+            && (radiance.abs().max_element() as f64) < crate::exact_sum::MAX_CONTRIBUTION;
+        self.rejected += !accepted as u32;
+        accepted
+    }
+
+    /// Adds `weight` × `radiance` and `weight` to the sums without counting a sample: a
+    /// share of a sample counted elsewhere ([`Self::count`]), or [`Self::add`]'s own.
+    /// Each term is rounded once, on its own (f32 × f32 is exact in f64), so the order in
+    /// which contributions arrive does not change the sums. Returns false, adding
+    /// nothing, where a term is not finite or beyond
+    /// [`crate::exact_sum::MAX_CONTRIBUTION`]; an accepted sample's shares (weights at
+    /// most 1) always fit.
+    #[inline]
+    pub fn add_weighted(&mut self, radiance: Vec3, weight: f32) -> bool {
+        let w = weight as f64;
+        let terms = [
+            ExactSum::of(radiance.x as f64 * w),
+            ExactSum::of(radiance.y as f64 * w),
+            ExactSum::of(radiance.z as f64 * w),
+            ExactSum::of(w),
+        ];
+        let [Some(r), Some(g), Some(b), Some(w)] = terms else {
+            return false;
+        };
+        for (sum, t) in self.radiance_sum.iter_mut().zip([r, g, b]) {
+            *sum += t;
+        }
+        self.weight_sum += w;
+        true
     }
 
     /// The pixel's estimate: the weighted mean of its samples (black if none).

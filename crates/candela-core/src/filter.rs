@@ -90,6 +90,25 @@ impl PixelFilter {
             }
         }
     }
+
+    /// How far from a sample, in pixels along each axis, the filter reaches.
+    pub fn radius(&self) -> f32 {
+        match self {
+            PixelFilter::Box => 0.5,
+            PixelFilter::Tent { radius } | PixelFilter::Gaussian { radius, .. } => *radius,
+        }
+    }
+
+    /// The filter's value along one axis at offset `x` from a pixel's centre, up to a
+    /// constant factor: its weight per axis when splatting (see [`crate::splat`]). The
+    /// Gaussian is evaluated exactly, not through the table.
+    pub fn eval_axis(&self, x: f32) -> f32 {
+        match self {
+            PixelFilter::Box => (x.abs() <= 0.5) as u32 as f32,
+            PixelFilter::Tent { radius } => (1.0 - x.abs() / radius).max(0.0),
+            PixelFilter::Gaussian { stddev, radius, .. } => gaussian(x, *stddev, *radius),
+        }
+    }
 }
 
 fn gaussian(x: f32, stddev: f32, radius: f32) -> f32 {

@@ -9,7 +9,7 @@ use glam::{UVec2, Vec2, Vec3};
 use rayon::prelude::*;
 
 use crate::bsdf::Bsdf;
-use crate::desc::{MisMode, SamplerKind};
+use crate::desc::{FilterSampling, MisMode, SamplerKind};
 use crate::film::{Film, Pixel};
 use crate::filter::PixelFilter;
 use crate::geometry::Ray;
@@ -103,8 +103,21 @@ pub fn render_with<S: Sampler>(
     let pass_spp = (spp / 16).clamp(1, 8);
     let mut stats = RenderStats::default();
     let mut start = samples.start;
+    let splat = scene.settings.filter_sampling == FilterSampling::Splat
+        && !matches!(scene.filter, PixelFilter::Box);
     while start < samples.end && !cancel.load(Ordering::Relaxed) {
         let pass = start..(start + pass_spp).min(samples.end);
+        if splat {
+            let ctx = PassCtx {
+                scene,
+                isa,
+                cancel,
+                progress,
+            };
+            stats = stats.add(crate::splat::render_pass(&ctx, &sampler, &mut film, &pass));
+            start = pass.end;
+            continue;
+        }
         let pass_stats = film
             .pixels
             .par_chunks_mut(w as usize * BAND_ROWS)
@@ -115,18 +128,18 @@ pub fn render_with<S: Sampler>(
                 }
                 let mut sampler = sampler.clone();
                 let done = pixels.len() as u64 * pass.len() as u64;
+                let y0 = (band * BAND_ROWS) as u32;
                 let band = Band {
-                    pixels,
+                    rows: y0..y0 + (pixels.len() / w as usize) as u32,
                     width: w,
-                    y0: (band * BAND_ROWS) as u32,
                     pass: pass.clone(),
                 };
-                let s = match isa {
-                    // SAFETY: the assertion above checked that the CPU has x86-64-v3.
-                    #[cfg(target_arch = "x86_64")]
-                    crate::desc::Isa::V3 => unsafe { render_pixels_v3(scene, &mut sampler, band) },
-                    _ => render_pixels::<S, false>(scene, &mut sampler, band),
+                let mut sink = OwnPixels {
+                    pixels,
+                    width: w,
+                    y0,
                 };
+                let s = render_band(scene, isa, &mut sampler, band, &mut sink);
                 progress(done);
                 s
             })
@@ -156,43 +169,95 @@ macro_rules! v3_fn {
 
 v3_fn! {
     /// [`render_pixels`] compiled for x86-64-v3.
-    fn render_pixels_v3<S: Sampler>(scene: &Scene, sampler: &mut S, band: Band) -> RenderStats {
-        render_pixels::<S, true>(scene, sampler, band)
+    fn render_pixels_v3<S: Sampler, K: SampleSink>(
+        scene: &Scene,
+        sampler: &mut S,
+        band: Band,
+        sink: &mut K,
+    ) -> RenderStats {
+        render_pixels::<S, K, true>(scene, sampler, band, sink)
     }
 }
 
-/// One work item: rows from `y0` of an image `width` pixels wide, and the sample indices
-/// to take in each of their pixels.
-struct Band<'a> {
+/// What a render pass shares with its work items.
+pub(crate) struct PassCtx<'a> {
+    pub scene: &'a Scene,
+    /// The resolved copy of the render loop (supported by the CPU).
+    pub isa: crate::desc::Isa,
+    pub cancel: &'a AtomicBool,
+    pub progress: &'a (dyn Fn(u64) + Sync),
+}
+
+/// One work item: rows `rows` of an image `width` pixels wide, and the sample indices to
+/// take in each of their pixels.
+pub(crate) struct Band {
+    pub rows: Range<u32>,
+    pub width: u32,
+    pub pass: Range<u32>,
+}
+
+/// Where a work item's samples go.
+pub(crate) trait SampleSink {
+    /// Whether samples are splatted: then each sample lies uniformly in its pixel and the
+    /// sink spreads it under the filter; else its offset is drawn from the filter.
+    const SPLATS: bool;
+    /// Takes the radiance `l` of a sample of pixel `p` at film position `film_pos`.
+    fn add(&mut self, p: UVec2, film_pos: Vec2, l: Vec3);
+}
+
+/// Filter importance sampling's sink: each sample to its own pixel, with weight 1.
+struct OwnPixels<'a> {
+    /// Rows from `y0`.
     pixels: &'a mut [Pixel],
     width: u32,
     y0: u32,
-    pass: Range<u32>,
+}
+
+impl SampleSink for OwnPixels<'_> {
+    const SPLATS: bool = false;
+    #[inline(always)]
+    fn add(&mut self, p: UVec2, _film_pos: Vec2, l: Vec3) {
+        self.pixels[((p.y - self.y0) * self.width + p.x) as usize].add(l, 1.0);
+    }
+}
+
+/// Takes a work item's samples with the render loop's copy `isa`, which the CPU must run.
+pub(crate) fn render_band<S: Sampler, K: SampleSink>(
+    scene: &Scene,
+    isa: crate::desc::Isa,
+    sampler: &mut S,
+    band: Band,
+    sink: &mut K,
+) -> RenderStats {
+    debug_assert!(isa.is_supported());
+    match isa {
+        // SAFETY: `render_with` asserted that the CPU has the resolved ISA.
+        #[cfg(target_arch = "x86_64")]
+        crate::desc::Isa::V3 => unsafe { render_pixels_v3(scene, sampler, band, sink) },
+        _ => render_pixels::<S, K, false>(scene, sampler, band, sink),
+    }
 }
 
 /// Takes a band's samples; inlined into each copy of the render loop, so that it and
 /// its callees are compiled for each. `V3`: whether this is the x86-64-v3 copy (which
 /// then calls the v3 copy of next event estimation).
 #[inline(always)]
-fn render_pixels<S: Sampler, const V3: bool>(
+fn render_pixels<S: Sampler, K: SampleSink, const V3: bool>(
     scene: &Scene,
     sampler: &mut S,
     band: Band,
+    sink: &mut K,
 ) -> RenderStats {
-    let Band {
-        pixels,
-        width,
-        y0,
-        pass,
-    } = band;
+    let Band { rows, width, pass } = band;
     let mut stats = RenderStats::default();
-    for (i, pixel) in pixels.iter_mut().enumerate() {
-        let p = UVec2::new(i as u32 % width, y0 + i as u32 / width);
+    let pixels = rows.flat_map(|y| (0..width).map(move |x| UVec2::new(x, y)));
+    for p in pixels {
         for index in pass.clone() {
             sampler.start_pixel_sample(p, index);
             let u_pixel = sampler.get_pixel_2d();
             let film_pos = match scene.filter {
                 PixelFilter::Box => p.as_vec2() + u_pixel,
+                _ if K::SPLATS => p.as_vec2() + u_pixel,
                 ref f => p.as_vec2() + 0.5 + f.sample(u_pixel),
             };
             // A pinhole takes no lens dimensions, so its streams are as they were.
@@ -204,7 +269,7 @@ fn render_pixels<S: Sampler, const V3: bool>(
             let ray = scene.camera.generate_lens_ray(film_pos, lens_u);
             let l = li_isa::<S, V3>(scene, ray, sampler, &mut stats.rays);
             stats.paths += 1;
-            pixel.add(l, 1.0);
+            sink.add(p, film_pos, l);
         }
     }
     stats

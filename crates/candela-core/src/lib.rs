@@ -55,6 +55,7 @@ pub mod photometry;
 pub mod sampler;
 pub mod sampling;
 pub mod scene;
+pub mod splat;
 pub mod texture;
 
 pub use scene::Scene;

@@ -301,6 +301,10 @@ fn environment_power_follows_scene_size_and_drives_light_selection() {
         materials: vec![material("m", Vec3::ONE)],
         shapes: vec![sphere(Vec3::ZERO, 1.0, "m")],
         environment: Some(env(EnvironmentMapDesc::Constant(Vec3::ONE))),
+        render: RenderSettings {
+            light_sampler: LightSamplerKind::Power,
+            ..Default::default()
+        },
         ..Default::default()
     };
     desc.lights.push(LightDesc {

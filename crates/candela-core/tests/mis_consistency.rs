@@ -16,11 +16,12 @@ use std::sync::atomic::AtomicBool;
 use std::sync::Arc;
 
 use candela_core::build::build;
-use candela_core::chi2::welch_p_samples;
 use candela_core::desc::*;
 use candela_core::integrator::render;
-use candela_core::math::luminance;
 use glam::{Mat4, Vec3};
+
+mod tile_welch;
+use tile_welch::push_tile_means;
 
 const RES: u32 = 64;
 const TILE: u32 = 8;
@@ -121,26 +122,14 @@ fn tile_means(
         let scene = build(&desc).expect("Cornell box builds");
         let film = render(&scene, 0..SPP, &AtomicBool::new(false), &|_| {}).film;
         let img = film.resolve();
-        let mut sums = vec![0.0f64; tiles * tiles];
-        for (i, v) in img.iter().enumerate() {
-            let (x, y) = (i as u32 % RES, i as u32 / RES);
-            sums[((y / TILE) * (RES / TILE) + x / TILE) as usize] += luminance(*v) as f64;
-        }
-        for (t, s) in sums.iter().enumerate() {
-            out[t].push(s / (TILE * TILE) as f64);
-        }
+        push_tile_means(&mut out, &img, RES, TILE);
     }
     out
 }
 
 /// Tiles whose Welch test rejects equality at [`ALPHA`].
 fn failing_tiles(a: &[Vec<f64>], b: &[Vec<f64>]) -> Vec<(usize, f64)> {
-    a.iter()
-        .zip(b)
-        .enumerate()
-        .map(|(i, (x, y))| (i, welch_p_samples(x, y)))
-        .filter(|&(_, p)| p < ALPHA)
-        .collect()
+    tile_welch::failing_tiles(a, b, ALPHA)
 }
 
 #[test]

@@ -17,7 +17,7 @@
 use std::path::Path;
 use std::sync::atomic::AtomicBool;
 
-use candela_core::desc::PixelFilterDesc;
+use candela_core::desc::{FilterSampling, PixelFilterDesc};
 use candela_core::integrator;
 use candela_scene::{load_scene_with, LoadOptions};
 use glam::Vec3;
@@ -194,6 +194,10 @@ fn render_at_depth(m: &str, spp: u32) -> Option<Vec<Vec3>> {
         .unwrap()
         .desc;
     desc.render.spp = spp;
+    // Each pixel keeps its own few samples, drawn from the scene's tent: then a pixel on
+    // the light's strip, one or two pixels tall here, can see nothing but the light.
+    // Splatting would mix in samples from up to a pixel around, off the strip.
+    desc.render.filter_sampling = FilterSampling::Importance;
     let scene = candela_core::build::build(&desc).unwrap();
     let film = integrator::render(&scene, 0..spp, &AtomicBool::new(false), &|_| {}).film;
     Some(film.resolve())

@@ -140,7 +140,9 @@ impl ImportanceBounds {
         let cos_x = cos_sub_clamped(sin_w, cos_w, self.sin_theta_o, self.cos_theta_o);
         let sin_x = sin_sub_clamped(sin_w, cos_w, self.sin_theta_o, self.cos_theta_o);
         let cos_p = cos_sub_clamped(sin_x, cos_x, sin_b, cos_b);
-        if cos_p <= self.cos_theta_e {
+        // Strictly beyond θ_e only: a light with θ_e = 0 (a projector's or a hard-edged
+        // spot's cone, emission exactly within θ_o) gives cos θ' = 1 inside its cone.
+        if cos_p < self.cos_theta_e {
             return 0.0;
         }
         let mut importance = self.intensity * cos_p / d2c;
@@ -192,4 +194,32 @@ pub fn cone_measure(cos_theta_o: f32, cos_theta_e: f32) -> f32 {
         + PI / 2.0
             * (2.0 * theta_w * sin_o - (theta_o - 2.0 * theta_w).cos() - 2.0 * theta_o * sin_o
                 + cos_theta_o)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A cone with no falloff (θ_e = 0, a projector's) has importance inside its cone and
+    /// none outside.
+    #[test]
+    fn a_cone_without_falloff_is_important_inside_it() {
+        let b = LightBounds {
+            aabb: Aabb::from_points(&[Vec3::new(0.0, 2.0, 0.0)]),
+            w: -Vec3::Y,
+            intensity: 1.0,
+            cos_theta_o: 30f32.to_radians().cos(),
+            cos_theta_e: 1.0,
+            two_sided: false,
+        };
+        let at = |x: f32| {
+            b.importance(&ShadingCtx {
+                p: Vec3::new(x, 0.0, 0.0),
+                n: Vec3::Y,
+            })
+        };
+        // tan 30° · 2 ≈ 1.155: the cone's edge on the floor.
+        assert!(at(0.0) > 0.0 && at(1.1) > 0.0);
+        assert_eq!(at(1.3), 0.0);
+    }
 }

@@ -20,8 +20,8 @@ mod values;
 use std::path::Path;
 
 use candela_core::desc::{
-    BsdfDesc, EmissionProfileDesc, LampSampling, LightSamplerKind, MaterialDesc, MisMode,
-    RenderSettings, SamplerKind, SceneDesc, ShapeMediaDesc,
+    BsdfDesc, EmissionProfileDesc, FilterSampling, LampSampling, LightSamplerKind, MaterialDesc,
+    MisMode, RenderSettings, SamplerKind, SceneDesc, ShapeMediaDesc,
 };
 use serde::de::DeserializeOwned;
 use serde::Deserialize;
@@ -214,6 +214,7 @@ struct RenderSection {
     ris_candidates: Option<std::num::NonZeroU32>,
     sampler: Option<SamplerKind>,
     aov: Option<Vec<candela_core::aov::AovKind>>,
+    filter_sampling: Option<FilterSampling>,
 }
 
 fn parse_render(src: &Source, value: Item) -> Result<RenderSettings, LoadError> {
@@ -236,6 +237,7 @@ fn parse_render(src: &Source, value: Item) -> Result<RenderSettings, LoadError> 
     }
     out.sampler = r.sampler.unwrap_or(out.sampler);
     out.aovs = r.aov.into_iter().flatten().collect();
+    out.filter_sampling = r.filter_sampling.unwrap_or(out.filter_sampling);
     Ok(out)
 }
 

@@ -1,0 +1,167 @@
+//! Splatting for pixel filters wider than a pixel, as Mitsuba does: each sample, uniform
+//! in its pixel, adds its radiance to every pixel under the filter centred on it, weighted
+//! by the filter's value at that pixel's centre, and each pixel divides by the sum of its
+//! weights ([`crate::film::Pixel::value`]). The expected image is the one filter
+//! importance sampling gives (a ratio estimator: consistent, not unbiased, as Mitsuba's),
+//! but a pixel averages about as many samples as the filter covers pixels, so at equal
+//! spp it is less noisy.
+//!
+//! Determinism: a work item (a band of rows) splats into a block of its own holding its
+//! rows and an apron of rows above and below as far as the filter reaches; the blocks are
+//! then added into the film one after another in the order of their bands. So every pixel
+//! sums the same numbers in the same order whatever the thread count or the order in
+//! which the bands ran.
+
+use std::ops::Range;
+use std::sync::atomic::Ordering;
+
+use glam::{UVec2, Vec2, Vec3};
+use rayon::prelude::*;
+
+use crate::film::{Film, Pixel};
+use crate::filter::PixelFilter;
+use crate::integrator::{render_band, Band, PassCtx, RenderStats, SampleSink};
+use crate::sampler::Sampler;
+
+/// Rows of samples per work item; its block holds the apron besides.
+const BAND_ROWS: u32 = 8;
+
+/// Renders one pass (sample indices `pass` of every pixel) into `film` by splatting.
+pub(crate) fn render_pass<S: Sampler>(
+    ctx: &PassCtx,
+    sampler: &S,
+    film: &mut Film,
+    pass: &Range<u32>,
+) -> RenderStats {
+    let (w, h) = (film.width, film.height);
+    let filter = &ctx.scene.filter;
+    let apron = apron_rows(filter.radius());
+    let bands: Vec<Range<u32>> = (0..h)
+        .step_by(BAND_ROWS as usize)
+        .map(|y0| y0..(y0 + BAND_ROWS).min(h))
+        .collect();
+    let blocks: Vec<(SplatBlock, RenderStats)> = bands
+        .into_par_iter()
+        .map(|rows| {
+            let y0 = rows.start.saturating_sub(apron);
+            let y1 = (rows.end + apron).min(h);
+            let mut block = SplatBlock {
+                filter,
+                width: w,
+                height: h,
+                y0,
+                pixels: vec![Pixel::default(); (w * (y1 - y0)) as usize],
+            };
+            if ctx.cancel.load(Ordering::Relaxed) {
+                return (block, RenderStats::default());
+            }
+            let done = rows.len() as u64 * w as u64 * pass.len() as u64;
+            let band = Band {
+                rows,
+                width: w,
+                pass: pass.clone(),
+            };
+            let mut sampler = sampler.clone();
+            let stats = render_band(ctx.scene, ctx.isa, &mut sampler, band, &mut block);
+            (ctx.progress)(done);
+            (block, stats)
+        })
+        .collect();
+    let mut stats = RenderStats::default();
+    for (block, s) in blocks {
+        let start = (block.y0 * w) as usize;
+        for (a, b) in film.pixels[start..].iter_mut().zip(&block.pixels) {
+            a.merge(b);
+        }
+        stats.paths += s.paths;
+        stats.rays += s.rays;
+    }
+    stats
+}
+
+/// Rows beyond a band that its samples can reach with a filter of radius `r`: a sample
+/// at height y ∈ [y₀, y₁) reaches the pixels whose centres lie within r of it.
+fn apron_rows(r: f32) -> u32 {
+    (r + 0.5).ceil() as u32
+}
+
+/// The pixels a filter of radius `r` reaches along one axis from a sample at `x`, clipped
+/// to `0..n`: those whose centre `q + ½` lies strictly within `r` of `x` (the filter is
+/// zero at its radius).
+fn footprint(x: f32, r: f32, n: u32) -> Range<u32> {
+    let lo = (x - 0.5 - r).floor() as i64 + 1;
+    let hi = (x - 0.5 + r).ceil() as i64;
+    (lo.max(0) as u32)..(hi.clamp(0, n as i64) as u32)
+}
+
+/// A work item's share of the film: rows from `y0`, the band's and its apron's.
+struct SplatBlock<'a> {
+    filter: &'a PixelFilter,
+    width: u32,
+    /// The image's height, which clips the footprint.
+    height: u32,
+    y0: u32,
+    pixels: Vec<Pixel>,
+}
+
+impl SampleSink for SplatBlock<'_> {
+    const SPLATS: bool = true;
+
+    fn add(&mut self, p: UVec2, film_pos: Vec2, l: Vec3) {
+        let row = |y: u32| ((y - self.y0) * self.width) as usize;
+        if !self.pixels[row(p.y) + p.x as usize].count(l) {
+            return;
+        }
+        let r = self.filter.radius();
+        let xs = footprint(film_pos.x, r, self.width);
+        // At most 2⌈r⌉ + 1 weights per axis; a wider filter is computed per pixel.
+        let mut wx = [0.0f32; 16];
+        let cached = xs.len() <= wx.len();
+        if cached {
+            for (w, x) in wx.iter_mut().zip(xs.clone()) {
+                *w = self.filter.eval_axis(x as f32 + 0.5 - film_pos.x);
+            }
+        }
+        for y in footprint(film_pos.y, r, self.height) {
+            let wy = self.filter.eval_axis(y as f32 + 0.5 - film_pos.y);
+            if wy == 0.0 {
+                continue;
+            }
+            let start = row(y);
+            for (i, x) in xs.clone().enumerate() {
+                let wx = if cached {
+                    wx[i]
+                } else {
+                    self.filter.eval_axis(x as f32 + 0.5 - film_pos.x)
+                };
+                if wx != 0.0 {
+                    self.pixels[start + x as usize].add_weighted(l, wx * wy);
+                }
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The footprint holds exactly the pixels whose centre is strictly within the radius,
+    /// and the apron covers every footprint of a band's samples.
+    #[test]
+    fn footprint_is_the_pixels_within_the_radius() {
+        for r in [0.5f32, 1.0, 1.5, 2.0, 2.3] {
+            for k in 0..=64 {
+                let x = 10.0 + k as f32 / 64.0 * 0.999;
+                let fp = footprint(x, r, 100);
+                for q in 0..100u32 {
+                    let inside = (q as f32 + 0.5 - x).abs() < r;
+                    assert_eq!(fp.contains(&q), inside, "r {r} x {x} q {q}");
+                }
+                assert!(fp.start >= 10 - apron_rows(r) && fp.end <= 11 + apron_rows(r));
+            }
+        }
+        assert_eq!(footprint(0.2, 2.0, 3), 0..2);
+        assert_eq!(footprint(0.2, 2.0, 1), 0..1);
+    }
+}
