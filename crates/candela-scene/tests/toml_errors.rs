@@ -30,7 +30,7 @@ fn unknown_top_level_table() {
     assert_eq!(
         error("[render]\nspp = 4\n[lights]\n"),
         "scene.toml:3:2: unknown key `lights`, expected one of `render`, `camera`, \
-         `materials`, `shape`, `light`, `environment`, `include`"
+         `materials`, `shape`, `light`, `environment`, `include`, `media`"
     );
 }
 
