@@ -1,12 +1,12 @@
 #!/usr/bin/env bash
 # The tests that need Intel Open Image Denoise 2.x (`--denoise`): installs the `pyoidn`
-# wheel from PyPI (libOpenImageDenoise.so.2 with its CPU device) into target/oidn-venv,
+# wheel from PyPI (libOpenImageDenoise.so.2 with its CPU device) into $CARGO_TARGET_DIR/oidn-venv,
 # points OIDN_DIR at its library and runs the denoising tests, failing if they skipped.
 # Idempotent (the venv is kept); a few minutes on 2 cores, most of it the 88 MB download
 # and one 64² Cornell reference at 1024 spp.
 set -euo pipefail
 cd "$(dirname "$0")/../.."
-venv=target/oidn-venv
+venv=${CARGO_TARGET_DIR:-target}/oidn-venv
 if ! "$venv/bin/python" -c 'import importlib.util as u; assert u.find_spec("pyoidn")' 2>/dev/null; then
     python3 -m venv "$venv"
     "$venv/bin/pip" install --quiet --no-deps pyoidn

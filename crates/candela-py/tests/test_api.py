@@ -153,9 +153,16 @@ def test_the_gil_is_released_while_rendering(scene_path):
 
     t = threading.Thread(target=tick)
     t.start()
-    start = time.monotonic()
-    candela.render(scene, spp=512, threads=1)
-    elapsed = time.monotonic() - start
+    # Long enough a render to count ticks in, whatever the machine's speed: the sample
+    # count doubles until one render takes 0.3 s (at most 2¹⁵ · 512 spp).
+    spp = 512
+    for _ in range(16):
+        start = time.monotonic()
+        candela.render(scene, spp=spp, threads=1)
+        elapsed = time.monotonic() - start
+        if elapsed > 0.3:
+            break
+        spp *= 2
     done.set()
     t.join()
     during = [x for x in ticks if start <= x <= start + elapsed]
