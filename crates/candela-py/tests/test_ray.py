@@ -42,7 +42,7 @@ def test_four_chunks_on_two_workers_equal_the_single_render(local_ray, scene_pat
 def test_a_killed_worker_is_retried_and_the_result_is_still_exact(local_ray, scene_path, tmp_path):
     log = tmp_path / "tasks"
     log.mkdir()
-    spp = 4096  # long enough chunks (a good fraction of a second each) to be killed mid-render
+    spp = 16384  # long enough chunks (a second or more each, even on a quiet machine) to be killed mid-render
     result = {}
 
     def run():
