@@ -238,6 +238,34 @@ pub(crate) fn render_band<S: Sampler, K: SampleSink>(
     }
 }
 
+/// Starts pixel sample `index` of pixel `p` and makes its camera ray: the film position
+/// (uniform in the pixel for the box filter and where the sample is splatted, else drawn
+/// from the filter) and the ray through it. A pinhole takes no lens dimensions, so its
+/// streams are as they were before lenses. The AOV pass makes its rays here too (with
+/// `splats` false: the filter's own positions).
+#[inline(always)]
+pub(crate) fn camera_ray<S: Sampler>(
+    scene: &Scene,
+    sampler: &mut S,
+    p: UVec2,
+    index: u32,
+    splats: bool,
+) -> (Vec2, Ray) {
+    sampler.start_pixel_sample(p, index);
+    let u_pixel = sampler.get_pixel_2d();
+    let film_pos = match scene.filter {
+        PixelFilter::Box => p.as_vec2() + u_pixel,
+        _ if splats => p.as_vec2() + u_pixel,
+        ref f => p.as_vec2() + 0.5 + f.sample(u_pixel),
+    };
+    let lens_u = if scene.camera.needs_lens_sample() {
+        sampler.get_2d()
+    } else {
+        Vec2::splat(0.5)
+    };
+    (film_pos, scene.camera.generate_lens_ray(film_pos, lens_u))
+}
+
 /// Takes a band's samples; inlined into each copy of the render loop, so that it and
 /// its callees are compiled for each. `V3`: whether this is the x86-64-v3 copy (which
 /// then calls the v3 copy of next event estimation).
@@ -253,20 +281,7 @@ fn render_pixels<S: Sampler, K: SampleSink, const V3: bool>(
     let pixels = rows.flat_map(|y| (0..width).map(move |x| UVec2::new(x, y)));
     for p in pixels {
         for index in pass.clone() {
-            sampler.start_pixel_sample(p, index);
-            let u_pixel = sampler.get_pixel_2d();
-            let film_pos = match scene.filter {
-                PixelFilter::Box => p.as_vec2() + u_pixel,
-                _ if K::SPLATS => p.as_vec2() + u_pixel,
-                ref f => p.as_vec2() + 0.5 + f.sample(u_pixel),
-            };
-            // A pinhole takes no lens dimensions, so its streams are as they were.
-            let lens_u = if scene.camera.needs_lens_sample() {
-                sampler.get_2d()
-            } else {
-                Vec2::splat(0.5)
-            };
-            let ray = scene.camera.generate_lens_ray(film_pos, lens_u);
+            let (film_pos, ray) = camera_ray(scene, sampler, p, index, K::SPLATS);
             let l = li_isa::<S, V3>(scene, ray, sampler, &mut stats.rays);
             stats.paths += 1;
             sink.add(p, film_pos, l);

@@ -3,12 +3,12 @@
 use std::ops::Range;
 use std::sync::atomic::{AtomicBool, Ordering};
 
-use glam::{UVec2, Vec2};
+use glam::UVec2;
 use rayon::prelude::*;
 
 use super::{first_surface, AovFilm, AovPixel};
 use crate::desc::SamplerKind;
-use crate::filter::PixelFilter;
+use crate::integrator::camera_ray;
 use crate::sampler::{IndependentSampler, Sampler, SobolCmjSampler, SobolSampler};
 use crate::scene::Scene;
 
@@ -69,19 +69,8 @@ fn render_pixel<S: Sampler>(
     pixel: &mut AovPixel,
 ) {
     for index in samples {
-        // The camera ray as `integrator::render_pixels` makes it, number for number.
-        sampler.start_pixel_sample(p, index);
-        let u_pixel = sampler.get_pixel_2d();
-        let film_pos = match scene.filter {
-            PixelFilter::Box => p.as_vec2() + u_pixel,
-            ref f => p.as_vec2() + 0.5 + f.sample(u_pixel),
-        };
-        let lens_u = if scene.camera.needs_lens_sample() {
-            sampler.get_2d()
-        } else {
-            Vec2::splat(0.5)
-        };
-        let ray = scene.camera.generate_lens_ray(film_pos, lens_u);
+        // The camera ray of the beauty's filter importance sampling, number for number.
+        let (_, ray) = camera_ray(scene, sampler, p, index, false);
         pixel.add(first_surface(scene, ray, sampler).as_ref());
     }
 }
