@@ -1,141 +1,16 @@
-//! The render-time scene: flat arrays addressed by small ids, a BVH over all primitives,
-//! and the queries the integrator asks of them.
+//! What a ray found: the hit record ([`SurfaceInteraction`]) and how it is made, for a
+//! triangle (every vertex attribute interpolated, instances carried to world space, and a
+//! fast path for bare meshes) and for a sphere.
 
-use glam::{Vec2, Vec3, Vec4};
+use glam::{Vec2, Vec3};
 
-use crate::accel::Accel;
-use crate::camera::Camera;
-use crate::desc::RenderSettings;
-use crate::filter::PixelFilter;
-use crate::geometry::{Aabb, Ray};
-use crate::instance::{Instance, Instances};
-use crate::light::{Light, LightId};
-use crate::light_sampler::LightSampler;
-use crate::material::{Material, MaterialId};
+use super::mesh::{winding_normal, Mesh, Prim};
+use super::Scene;
+use crate::geometry::Ray;
+use crate::instance::Instance;
+use crate::light::LightId;
+use crate::material::MaterialId;
 use crate::math::offset_ray_origin;
-
-/// A triangle mesh in world space.
-#[derive(Clone, Debug)]
-pub struct Mesh {
-    pub positions: Vec<Vec3>,
-    /// Empty, or one unit normal per position.
-    pub normals: Vec<Vec3>,
-    /// Empty, or one per position.
-    pub uvs: Vec<Vec2>,
-    /// Empty, or one linear RGB vertex colour per position (see [`crate::desc::MeshDesc`]).
-    pub colors: Vec<Vec3>,
-    /// Empty, or one tangent per position: xyz along +u, w = ±1 the handedness (see
-    /// [`crate::desc::MeshDesc`]).
-    pub tangents: Vec<Vec4>,
-    pub indices: Vec<[u32; 3]>,
-    pub material: MaterialId,
-    /// Light of each triangle, if the mesh emits (same length as `indices`).
-    pub lights: Vec<LightId>,
-    /// Geometric normals point away from the winding's front side when set.
-    pub flip_normals: bool,
-    /// Empty, or [`Mesh::geometric_normal`] of each triangle, cached by
-    /// [`Mesh::cache_face_normals`] once the mesh is final (world space, `flip_normals`
-    /// set): a hit then loads its normal instead of a cross product, a square root and a
-    /// division on the path's critical chain. Bit for bit what the hit would compute.
-    pub face_normals: Vec<Vec3>,
-    /// Where the surface is cut out or see-through (glTF alpha modes); see [`crate::alpha`].
-    pub alpha: Option<crate::alpha::AlphaMask>,
-}
-
-impl Mesh {
-    #[inline]
-    pub fn vertices(&self, tri: u32) -> [Vec3; 3] {
-        let [a, b, c] = self.indices[tri as usize];
-        [
-            self.positions[a as usize],
-            self.positions[b as usize],
-            self.positions[c as usize],
-        ]
-    }
-
-    /// Texture coordinates at barycentrics (b1, b2) of a triangle (the barycentrics
-    /// themselves where the mesh has no uvs, as [`Scene::intersect`] reports them).
-    #[inline]
-    pub fn uv_at(&self, tri: u32, bary: Vec2) -> Vec2 {
-        if self.uvs.is_empty() {
-            return bary;
-        }
-        let [a, b, c] = self.indices[tri as usize].map(|i| i as usize);
-        self.uvs[a] * (1.0 - bary.x - bary.y) + self.uvs[b] * bary.x + self.uvs[c] * bary.y
-    }
-
-    /// Whether the mesh has positions only: no normals, uvs, tangents or colours.
-    #[inline]
-    pub fn is_bare(&self) -> bool {
-        self.normals.is_empty()
-            && self.uvs.is_empty()
-            && self.tangents.is_empty()
-            && self.colors.is_empty()
-    }
-
-    /// Unit geometric normal of a triangle: from the winding, turned towards the shading
-    /// normals where the mesh has them, and flipped by `flip_normals`. Zero for a
-    /// degenerate triangle.
-    #[inline]
-    pub fn geometric_normal(&self, tri: u32) -> Vec3 {
-        if let Some(&n) = self.face_normals.get(tri as usize) {
-            return n;
-        }
-        self.winding_normal_of(tri)
-    }
-
-    /// Fills [`Mesh::face_normals`]; to be called after the last change to the positions,
-    /// normals, indices or `flip_normals` of a world-space mesh (as
-    /// [`crate::build::build`] does).
-    pub fn cache_face_normals(&mut self) {
-        self.face_normals = (0..self.indices.len() as u32)
-            .map(|tri| self.winding_normal_of(tri))
-            .collect();
-    }
-
-    /// [`Self::geometric_normal`] from the vertices, not the cache.
-    fn winding_normal_of(&self, tri: u32) -> Vec3 {
-        let [a, b, c] = self.indices[tri as usize].map(|i| i as usize);
-        let normals =
-            (!self.normals.is_empty()).then(|| self.normals[a] + self.normals[b] + self.normals[c]);
-        winding_normal(self.vertices(tri), normals, self.flip_normals)
-    }
-}
-
-/// The unit normal of the winding of `p`, turned towards `normals` (the sum of the
-/// vertices' shading normals) where given, and flipped by `flip`.
-#[inline]
-fn winding_normal(p: [Vec3; 3], normals: Option<Vec3>, flip: bool) -> Vec3 {
-    let [p0, p1, p2] = p;
-    let mut n = (p1 - p0).cross(p2 - p0).normalize_or_zero();
-    if let Some(ns) = normals {
-        if n.dot(ns) < 0.0 {
-            n = -n;
-        }
-    }
-    if flip {
-        -n
-    } else {
-        n
-    }
-}
-
-#[derive(Clone, Debug)]
-pub struct Sphere {
-    pub center: Vec3,
-    pub radius: f32,
-    pub material: MaterialId,
-    pub light: Option<LightId>,
-    /// Normals point inwards.
-    pub flip_normals: bool,
-}
-
-/// A primitive in the BVH.
-#[derive(Clone, Copy, Debug)]
-pub enum Prim {
-    Triangle { mesh: u32, tri: u32 },
-    Sphere(u32),
-}
 
 /// What a ray found.
 #[derive(Clone, Copy, Debug)]
@@ -176,135 +51,19 @@ impl SurfaceInteraction {
 /// dozen instructions where this takes a few; it turns a ray's offset normal towards the
 /// side it leaves, three times a bounce.
 #[inline(always)]
-fn negated_unless(n: Vec3, keep: bool) -> Vec3 {
+pub(super) fn negated_unless(n: Vec3, keep: bool) -> Vec3 {
     n * if keep { 1.0 } else { -1.0 }
 }
 
-/// The scene as the integrator sees it. Made by [`crate::build::build`].
-#[derive(Clone, Debug)]
-pub struct Scene {
-    pub camera: Camera,
-    pub filter: PixelFilter,
-    pub settings: RenderSettings,
-    pub meshes: Vec<Mesh>,
-    pub spheres: Vec<Sphere>,
-    pub materials: Vec<Material>,
-    pub lights: Vec<Light>,
-    /// Lights that escaped rays see.
-    pub infinite_lights: Vec<LightId>,
-    pub light_sampler: LightSampler,
-    /// Every primitive, in the order of [`Scene::accel`]'s primitive indices.
-    pub prims: Vec<Prim>,
-    pub accel: Accel,
-    /// Meshes shared by several shapes, stored once and placed by transforms.
-    pub instances: Instances,
-    /// Participating media and null surfaces; where set, the volumetric path tracer renders.
-    pub media: Option<Box<crate::medium::SceneMedia>>,
-}
-
 impl Scene {
-    pub fn bounds(&self) -> Aabb {
-        self.accel.bounds().union(self.instances.bounds())
-    }
-
-    /// Triangles as rendered: each instance counts its mesh's triangles.
-    pub fn triangle_count(&self) -> usize {
-        self.flat_triangle_count() + self.instances.instanced_triangles()
-    }
-
-    /// Triangles held in memory: flattened meshes plus each shared mesh once.
-    pub fn stored_triangle_count(&self) -> usize {
-        self.flat_triangle_count() + self.instances.stored_triangles()
-    }
-
-    fn flat_triangle_count(&self) -> usize {
-        self.meshes.iter().map(|m| m.indices.len()).sum()
-    }
-
-    #[inline]
-    pub fn light(&self, id: LightId) -> &Light {
-        &self.lights[id.0 as usize]
-    }
-
-    /// The nearest surface along the ray within (0, t_max).
-    ///
-    /// Inlined, with the instances and spheres out of line: the hit record of a flat
-    /// triangle, the common case, is built in the caller with no call. (Inlining the rare
-    /// paths too, so that no record comes back through memory, measured no faster.)
     #[inline(always)]
-    pub fn intersect(&self, ray: &Ray, t_max: f32) -> Option<SurfaceInteraction> {
-        let hit = self
-            .accel
-            .intersect(ray, t_max, |i, hit| self.alpha_accepts(i, hit, ray));
-        if !self.instances.is_empty() {
-            if let Some(si) = self.intersect_instances(ray, hit.map_or(t_max, |h| h.t)) {
-                return Some(si);
-            }
-        }
-        let hit = hit?;
-        let prim = self.prims[hit.prim as usize];
-        Some(self.interaction(ray, prim, hit.t, Vec2::new(hit.b1, hit.b2)))
-    }
-
-    /// The nearest instanced surface along the ray within (0, t_max).
-    #[inline(never)]
-    fn intersect_instances(&self, ray: &Ray, t_max: f32) -> Option<SurfaceInteraction> {
-        let filter = |inst, tri, hit: &_| self.instance_alpha_accepts(inst, tri, hit, ray);
-        let h = self.instances.intersect(ray, t_max, filter)?;
-        let inst = &self.instances.instances[h.instance as usize];
-        let m = &self.instances.meshes[inst.mesh as usize];
-        Some(triangle_interaction(
-            m,
-            Some(inst),
-            h.tri,
-            h.t,
-            Vec2::new(h.b1, h.b2),
-        ))
-    }
-
-    /// Whether anything lies on the ray within (0, t_max).
-    #[inline]
-    pub fn occluded(&self, ray: &Ray, t_max: f32) -> bool {
-        self.accel
-            .occluded(ray, t_max, |i, hit| self.alpha_accepts(i, hit, ray))
-            || (!self.instances.is_empty()
-                && self.instances.occluded(ray, t_max, |inst, tri, hit| {
-                    self.instance_alpha_accepts(inst, tri, hit, ray)
-                }))
-    }
-
-    /// Whether the segment from surface point `from` (normal `n_from`) to point `to`
-    /// (normal `n_to`, zero for a point light) is unblocked. Both ends are moved off their
-    /// surfaces so that neither surface blocks its own ray.
-    #[inline]
-    pub fn unoccluded(&self, from: Vec3, n_from: Vec3, to: Vec3, n_to: Vec3) -> bool {
-        let d = to - from;
-        let o = offset_ray_origin(from, negated_unless(n_from, d.dot(n_from) >= 0.0));
-        let target = if n_to == Vec3::ZERO {
-            to
-        } else {
-            offset_ray_origin(to, negated_unless(n_to, d.dot(n_to) <= 0.0))
-        };
-        let d = target - o;
-        let dist = d.length();
-        // Not 0 < dist < ∞ (NaN included): two compares, where `is_finite` was a dozen
-        // integer instructions on the bits.
-        if !(dist > 0.0 && dist < f32::INFINITY) {
-            return dist == 0.0;
-        }
-        // A relative margin keeps the far end from blocking itself.
-        !self.occluded(&Ray::new(o, d * (1.0 / dist)), dist * (1.0 - 1e-4))
-    }
-
-    /// Whether a ray leaving `from` towards `d` escapes the scene.
-    #[inline]
-    pub fn escapes(&self, from: Vec3, n_from: Vec3, d: Vec3) -> bool {
-        let o = offset_ray_origin(from, negated_unless(n_from, d.dot(n_from) >= 0.0));
-        !self.occluded(&Ray::new(o, d), f32::INFINITY)
-    }
-
-    #[inline(always)]
-    fn interaction(&self, ray: &Ray, prim: Prim, t: f32, bary: Vec2) -> SurfaceInteraction {
+    pub(super) fn interaction(
+        &self,
+        ray: &Ray,
+        prim: Prim,
+        t: f32,
+        bary: Vec2,
+    ) -> SurfaceInteraction {
         match prim {
             Prim::Triangle { mesh, tri } => {
                 triangle_interaction(&self.meshes[mesh as usize], None, tri, t, bary)
@@ -346,7 +105,7 @@ impl Scene {
 /// where `inst` is `None`, else an instance's, whose object-space vertex data is carried to
 /// world space first by the same [`crate::instance::Transform`] that flattens meshes.
 #[inline(always)]
-fn triangle_interaction(
+pub(super) fn triangle_interaction(
     m: &Mesh,
     inst: Option<&Instance>,
     tri: u32,

@@ -1,0 +1,69 @@
+//! The compiled copies of the render loop: one for the build's target (baseline) and,
+//! on x86-64, one for x86-64-v3 (AVX2, FMA, BMI1/2), chosen per render by
+//! [`crate::desc::Isa`] (see [`crate::isa`]). A copy is the band loop and everything it
+//! inlines; next event estimation, kept out of line, has a copy of its own for each.
+
+use glam::Vec3;
+
+use super::band::{render_pixels, Band, SampleSink};
+use super::direct::{sample_direct, NeeVertex};
+use super::RenderStats;
+use crate::sampler::Sampler;
+use crate::scene::Scene;
+
+/// Marks a function compiled for x86-64-v3 (see [`crate::isa`]; the list is the one
+/// `Isa::is_supported` detects).
+macro_rules! v3_fn {
+    ($f:item) => {
+        #[cfg(target_arch = "x86_64")]
+        #[target_feature(
+            enable = "avx,avx2,bmi1,bmi2,cmpxchg16b,f16c,fma,lzcnt,movbe,popcnt,sse3,sse4.1,sse4.2,ssse3,xsave"
+        )]
+        $f
+    };
+}
+
+v3_fn! {
+    /// [`render_pixels`] compiled for x86-64-v3.
+    fn render_pixels_v3<S: Sampler, K: SampleSink>(
+        scene: &Scene,
+        sampler: &mut S,
+        band: Band,
+        sink: &mut K,
+    ) -> RenderStats {
+        render_pixels::<S, K, true>(scene, sampler, band, sink)
+    }
+}
+
+/// Takes a work item's samples with the render loop's copy `isa`, which the CPU must run.
+pub(crate) fn render_band<S: Sampler, K: SampleSink>(
+    scene: &Scene,
+    isa: crate::desc::Isa,
+    sampler: &mut S,
+    band: Band,
+    sink: &mut K,
+) -> RenderStats {
+    debug_assert!(isa.is_supported());
+    match isa {
+        // SAFETY: `render_with` asserted that the CPU has the resolved ISA.
+        #[cfg(target_arch = "x86_64")]
+        crate::desc::Isa::V3 => unsafe { render_pixels_v3(scene, sampler, band, sink) },
+        _ => render_pixels::<S, K, false>(scene, sampler, band, sink),
+    }
+}
+
+/// [`sample_direct`] for the baseline target, out of line (inlined into the loop it
+/// measured slower).
+#[inline(never)]
+pub(super) fn sample_direct_baseline(scene: &Scene, v: &NeeVertex, rays: &mut u64) -> Vec3 {
+    sample_direct(scene, v, rays)
+}
+
+v3_fn! {
+    /// [`sample_direct`] compiled for x86-64-v3, out of line, called by the v3 copy of the
+    /// loop.
+    #[inline(never)]
+    pub(super) fn sample_direct_v3(scene: &Scene, v: &NeeVertex, rays: &mut u64) -> Vec3 {
+        sample_direct(scene, v, rays)
+    }
+}

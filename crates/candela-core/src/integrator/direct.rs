@@ -1,0 +1,126 @@
+//! Direct light at a path vertex: next event estimation towards one light picked by the
+//! scene's light sampler, a shadow ray, and the multiple importance sampling weight
+//! against BSDF sampling of the same direction (Veach 1997, ch. 9).
+
+use glam::{Vec2, Vec3};
+
+use crate::bsdf::Bsdf;
+use crate::desc::MisMode;
+use crate::light::{Light, LightSample, LightSource, ShadingCtx};
+use crate::light_sampler::LightPick;
+use crate::sampling::{balance_heuristic, power_heuristic};
+use crate::scene::{Scene, SurfaceInteraction};
+
+/// MIS weight of a strategy with density `pdf_f` against one with density `pdf_g`.
+pub(super) fn mis_weight(mode: MisMode, pdf_f: f32, pdf_g: f32) -> f32 {
+    match mode {
+        MisMode::Power => power_heuristic(pdf_f, pdf_g),
+        _ => balance_heuristic(pdf_f, pdf_g),
+    }
+}
+
+/// What next event estimation at a path vertex takes.
+#[derive(Clone, Copy)]
+pub(super) struct NeeVertex<'a> {
+    pub(super) si: &'a SurfaceInteraction,
+    pub(super) ctx: &'a ShadingCtx,
+    pub(super) bsdf: &'a Bsdf,
+    pub(super) wo: Vec3,
+    /// The light pick's number (see `BounceSamples::light` in `path`).
+    pub(super) u_light: f32,
+    /// The point on the light.
+    pub(super) u_point: Vec2,
+}
+
+/// Next event estimation: one light picked by the light sampler, one point on it, a
+/// shadow ray, and the MIS weight against BSDF sampling of the same direction.
+#[inline(always)]
+pub(super) fn sample_direct(scene: &Scene, v: &NeeVertex, rays: &mut u64) -> Vec3 {
+    let NeeVertex {
+        si,
+        ctx,
+        bsdf,
+        wo,
+        u_light,
+        u_point,
+    } = *v;
+    let mode = scene.settings.mis;
+    let Some(pick) = scene.light_sampler.sample(ctx, u_light, &scene.lights) else {
+        return Vec3::ZERO;
+    };
+    let id = pick.id;
+    let light = scene.light(id);
+    // BSDF-only estimation still needs NEE for delta lights, which no ray can hit.
+    if mode == MisMode::BsdfOnly && !light.is_delta() {
+        return Vec3::ZERO;
+    }
+    // Flat area lights, most scenes' lamps, get a copy of the rest of NEE of their own:
+    // merged with the other lights' samples, which come back through memory, their sample
+    // went through the stack too, stored field by field and loaded back in other pieces (a
+    // failed store forwarding on every shadow ray).
+    let ls = match light {
+        Light::Parallelogram(p) => p.sample_li(ctx, u_point),
+        Light::Triangle(t) => t.sample_li(ctx, u_point),
+        _ => {
+            return light_contribution(
+                scene,
+                si,
+                bsdf,
+                wo,
+                &pick,
+                light.sample_li(ctx, u_point),
+                rays,
+            )
+        }
+    };
+    light_contribution(
+        scene,
+        si,
+        bsdf,
+        wo,
+        &pick,
+        ls.and_then(LightSample::usable),
+        rays,
+    )
+}
+
+/// The rest of [`sample_direct`], from the light's sample on: the BSDF, the shadow ray and
+/// the MIS weight.
+#[inline(always)]
+fn light_contribution(
+    scene: &Scene,
+    si: &SurfaceInteraction,
+    bsdf: &Bsdf,
+    wo: Vec3,
+    pick: &LightPick,
+    ls: Option<LightSample>,
+    rays: &mut u64,
+) -> Vec3 {
+    let mode = scene.settings.mis;
+    let Some(ls) = ls else {
+        return Vec3::ZERO;
+    };
+    let (f, bsdf_pdf) = bsdf.f_cos_pdf(wo, ls.wi);
+    if f == Vec3::ZERO {
+        return Vec3::ZERO;
+    }
+    *rays += 1;
+    let visible = if ls.distance.is_finite() {
+        scene.unoccluded(si.p, si.ng, ls.p_light, ls.n_light)
+    } else {
+        scene.escapes(si.p, si.ng, ls.wi)
+    };
+    if !visible {
+        return Vec3::ZERO;
+    }
+    // For RIS, `pick.pmf` is 1/W (the unbiased RIS weight) and `pick.mis_pmf` a tractable
+    // surrogate of the pick probability; `emitter_weight` uses the same surrogate
+    // (`LightSampler::pmf`), so the NEE and BSDF weights of any (light, direction) still
+    // sum to one (see `light_sampler::ris`). For the other samplers the two are equal.
+    let weight = match mode {
+        _ if ls.is_delta => 1.0,
+        MisMode::NeeOnly => 1.0,
+        _ => mis_weight(mode, pick.mis_pmf * ls.pdf, bsdf_pdf),
+    };
+    f * ls.radiance * (weight / (pick.pmf * ls.pdf))
+}

@@ -1,0 +1,201 @@
+//! The path loop for scenes without media: at each vertex the emission found, next event
+//! estimation (see `direct`), a BSDF-sampled bounce and Russian roulette on the
+//! throughput. Scenes with media go to `volpath` instead.
+
+use glam::{Vec2, Vec3};
+
+use super::copies::sample_direct_baseline;
+#[cfg(target_arch = "x86_64")]
+use super::copies::sample_direct_v3;
+use super::direct::{mis_weight, NeeVertex};
+use super::volpath;
+use crate::desc::MisMode;
+use crate::geometry::Ray;
+use crate::light::{LightId, ShadingCtx};
+use crate::math::max_component;
+use crate::sampler::Sampler;
+use crate::scene::Scene;
+
+/// Radiance arriving along `ray`, estimated by one path.
+#[inline(always)]
+pub fn li<S: Sampler>(scene: &Scene, ray: Ray, sampler: &mut S, rays: &mut u64) -> Vec3 {
+    li_isa::<S, false>(scene, ray, sampler, rays)
+}
+
+/// [`li`] in the copy of the render loop `V3` says (see [`super::band::render_pixels`]).
+#[inline(always)]
+pub(super) fn li_isa<S: Sampler, const V3: bool>(
+    scene: &Scene,
+    mut ray: Ray,
+    sampler: &mut S,
+    rays: &mut u64,
+) -> Vec3 {
+    if let Some(media) = scene.media.as_deref() {
+        return volpath::li(scene, media, ray, sampler, rays);
+    }
+    let mode = scene.settings.mis;
+    let mut l = Vec3::ZERO;
+    let mut beta = Vec3::ONE;
+    // The product of η′² over the refractions so far (see `Bsdf::eta_crossed_sq`).
+    let mut eta_scale = 1.0f32;
+    let mut depth = 0u32;
+    // Whether the path's last bounce was a delta lobe (or the path just left the camera):
+    // then no light sampling could have found what the ray hits, so it counts in full.
+    let mut specular = true;
+    let mut prev_ctx = ShadingCtx {
+        p: ray.o,
+        n: Vec3::ZERO,
+    };
+    let mut prev_bsdf_pdf = 0.0f32;
+
+    // Weight of emission found by BSDF sampling, against NEE having found it.
+    let emitter_weight = |specular: bool,
+                          prev_ctx: &ShadingCtx,
+                          prev_bsdf_pdf: f32,
+                          id: LightId,
+                          d: Vec3| match mode {
+        _ if specular => 1.0,
+        MisMode::BsdfOnly => 1.0,
+        MisMode::NeeOnly => 0.0,
+        MisMode::Balance | MisMode::Power => {
+            let light_pdf =
+                scene.light_sampler.pmf(prev_ctx, id) * scene.light(id).pdf_li(prev_ctx, d);
+            mis_weight(mode, prev_bsdf_pdf, light_pdf)
+        }
+    };
+
+    loop {
+        *rays += 1;
+        // This bounce's numbers come before the traversal: they do not depend on the hit,
+        // and their hashing (tens of cycles of dependent multiplies) then overlaps the
+        // traversal instead of following it on the path's critical chain. The dimensions
+        // are those of drawing them where they are used; a path that ends here wastes them.
+        let u = (depth < scene.settings.max_depth).then(
+            #[inline(always)]
+            || BounceSamples::<S>::draw(scene, sampler),
+        );
+        let hit = scene.intersect(&ray, f32::INFINITY);
+        if depth == 0
+            && scene.settings.hide_emitters
+            && hit.as_ref().is_none_or(|si| si.light.is_some())
+        {
+            break;
+        }
+        let Some(si) = hit.as_ref() else {
+            for &id in &scene.infinite_lights {
+                let light = scene.light(id);
+                let le = if depth == 0 {
+                    light.le_camera(&ray)
+                } else {
+                    light.le(&ray)
+                };
+                if le != Vec3::ZERO {
+                    l += beta * le * emitter_weight(specular, &prev_ctx, prev_bsdf_pdf, id, ray.d);
+                }
+            }
+            break;
+        };
+        let wo = -ray.d;
+        if let Some(id) = si.light {
+            let le = scene.light(id).radiance(si.ng, si.uv, wo);
+            if le != Vec3::ZERO {
+                l += beta * le * emitter_weight(specular, &prev_ctx, prev_bsdf_pdf, id, ray.d);
+            }
+        }
+        let Some(u) = u else {
+            break;
+        };
+
+        let bsdf = scene.materials[si.material.0 as usize].bsdf_at(si);
+        let ctx = ShadingCtx { p: si.p, n: si.ns };
+        // The next direction first: it does not depend on light sampling, so its chain of
+        // divisions and square roots runs while the shadow ray is traced.
+        let u_lobe = if bsdf.lobe.takes_lobe_sample() {
+            sampler.resolve_1d(u.lobe)
+        } else {
+            0.5
+        };
+        let bs = bsdf.sample(wo, u_lobe, u.dir);
+        if !bsdf.is_delta() {
+            let v = NeeVertex {
+                si,
+                ctx: &ctx,
+                bsdf: &bsdf,
+                wo,
+                u_light: u.light,
+                u_point: u.point,
+            };
+            l += beta
+                * match V3 {
+                    // SAFETY: only the v3 copy of the render loop has `V3`, and `render_with`
+                    // asserted that the CPU runs it.
+                    #[cfg(target_arch = "x86_64")]
+                    true => unsafe { sample_direct_v3(scene, &v, rays) },
+                    _ => sample_direct_baseline(scene, &v, rays),
+                };
+        }
+        let Some(bs) = bs else {
+            break;
+        };
+        beta *= bs.f * (bsdf.abs_cos(bs.wi) / bs.pdf);
+        specular = bs.flags.is_delta();
+        prev_bsdf_pdf = bs.pdf;
+        prev_ctx = ctx;
+        ray = si.spawn_ray(bs.wi);
+        depth += 1;
+
+        eta_scale *= bsdf.eta_crossed_sq(wo, &bs);
+        if depth < scene.settings.rr_depth {
+            sampler.skip_1d();
+        } else {
+            let u_rr = sampler.get_1d();
+            // Survival in proportion to the throughput, so survivors carry weight ~1.
+            // No cap below 1 (Mitsuba caps at 0.95): in a white furnace a cap makes the
+            // weights grow by 1/0.95 per bounce and the variance unbounded.
+            let q = (1.0 - max_component(beta) * eta_scale).max(0.0);
+            if u_rr < q {
+                break;
+            }
+            beta *= 1.0 / (1.0 - q);
+        }
+        if beta == Vec3::ZERO || !beta.is_finite() {
+            break;
+        }
+    }
+    l
+}
+
+/// The numbers one bounce takes, in the order of their dimensions.
+struct BounceSamples<S: Sampler> {
+    /// The light pick (0.5, its dimension skipped, where there is one light).
+    light: f32,
+    /// The point on the light.
+    point: Vec2,
+    /// The BSDF's lobe choice, deferred: the hit is not known yet, and most BSDFs (one
+    /// lobe) do not read it.
+    lobe: S::Deferred1d,
+    /// The BSDF direction.
+    dir: Vec2,
+}
+
+impl<S: Sampler> BounceSamples<S> {
+    #[inline(always)]
+    fn draw(scene: &Scene, sampler: &mut S) -> BounceSamples<S> {
+        // A number nothing reads is skipped, not computed (its dimension stays taken).
+        let light = if scene.lights.len() > 1 {
+            sampler.get_1d()
+        } else {
+            sampler.skip_1d();
+            0.5
+        };
+        let point = sampler.get_2d();
+        let lobe = sampler.defer_1d();
+        let dir = sampler.get_2d();
+        BounceSamples {
+            light,
+            point,
+            lobe,
+            dir,
+        }
+    }
+}

@@ -1,0 +1,130 @@
+//! The render-time primitives: triangle meshes in world space (or object space, where
+//! instanced), spheres, and the id of a primitive in the BVH.
+
+use glam::{Vec2, Vec3, Vec4};
+
+use crate::light::LightId;
+use crate::material::MaterialId;
+
+/// A triangle mesh in world space.
+#[derive(Clone, Debug)]
+pub struct Mesh {
+    pub positions: Vec<Vec3>,
+    /// Empty, or one unit normal per position.
+    pub normals: Vec<Vec3>,
+    /// Empty, or one per position.
+    pub uvs: Vec<Vec2>,
+    /// Empty, or one linear RGB vertex colour per position (see [`crate::desc::MeshDesc`]).
+    pub colors: Vec<Vec3>,
+    /// Empty, or one tangent per position: xyz along +u, w = ±1 the handedness (see
+    /// [`crate::desc::MeshDesc`]).
+    pub tangents: Vec<Vec4>,
+    pub indices: Vec<[u32; 3]>,
+    pub material: MaterialId,
+    /// Light of each triangle, if the mesh emits (same length as `indices`).
+    pub lights: Vec<LightId>,
+    /// Geometric normals point away from the winding's front side when set.
+    pub flip_normals: bool,
+    /// Empty, or [`Mesh::geometric_normal`] of each triangle, cached by
+    /// [`Mesh::cache_face_normals`] once the mesh is final (world space, `flip_normals`
+    /// set): a hit then loads its normal instead of a cross product, a square root and a
+    /// division on the path's critical chain. Bit for bit what the hit would compute.
+    pub face_normals: Vec<Vec3>,
+    /// Where the surface is cut out or see-through (glTF alpha modes); see [`crate::alpha`].
+    pub alpha: Option<crate::alpha::AlphaMask>,
+}
+
+impl Mesh {
+    #[inline]
+    pub fn vertices(&self, tri: u32) -> [Vec3; 3] {
+        let [a, b, c] = self.indices[tri as usize];
+        [
+            self.positions[a as usize],
+            self.positions[b as usize],
+            self.positions[c as usize],
+        ]
+    }
+
+    /// Texture coordinates at barycentrics (b1, b2) of a triangle (the barycentrics
+    /// themselves where the mesh has no uvs, as [`super::Scene::intersect`] reports them).
+    #[inline]
+    pub fn uv_at(&self, tri: u32, bary: Vec2) -> Vec2 {
+        if self.uvs.is_empty() {
+            return bary;
+        }
+        let [a, b, c] = self.indices[tri as usize].map(|i| i as usize);
+        self.uvs[a] * (1.0 - bary.x - bary.y) + self.uvs[b] * bary.x + self.uvs[c] * bary.y
+    }
+
+    /// Whether the mesh has positions only: no normals, uvs, tangents or colours.
+    #[inline]
+    pub fn is_bare(&self) -> bool {
+        self.normals.is_empty()
+            && self.uvs.is_empty()
+            && self.tangents.is_empty()
+            && self.colors.is_empty()
+    }
+
+    /// Unit geometric normal of a triangle: from the winding, turned towards the shading
+    /// normals where the mesh has them, and flipped by `flip_normals`. Zero for a
+    /// degenerate triangle.
+    #[inline]
+    pub fn geometric_normal(&self, tri: u32) -> Vec3 {
+        if let Some(&n) = self.face_normals.get(tri as usize) {
+            return n;
+        }
+        self.winding_normal_of(tri)
+    }
+
+    /// Fills [`Mesh::face_normals`]; to be called after the last change to the positions,
+    /// normals, indices or `flip_normals` of a world-space mesh (as
+    /// [`crate::build::build`] does).
+    pub fn cache_face_normals(&mut self) {
+        self.face_normals = (0..self.indices.len() as u32)
+            .map(|tri| self.winding_normal_of(tri))
+            .collect();
+    }
+
+    /// [`Self::geometric_normal`] from the vertices, not the cache.
+    fn winding_normal_of(&self, tri: u32) -> Vec3 {
+        let [a, b, c] = self.indices[tri as usize].map(|i| i as usize);
+        let normals =
+            (!self.normals.is_empty()).then(|| self.normals[a] + self.normals[b] + self.normals[c]);
+        winding_normal(self.vertices(tri), normals, self.flip_normals)
+    }
+}
+
+/// The unit normal of the winding of `p`, turned towards `normals` (the sum of the
+/// vertices' shading normals) where given, and flipped by `flip`.
+#[inline]
+pub(super) fn winding_normal(p: [Vec3; 3], normals: Option<Vec3>, flip: bool) -> Vec3 {
+    let [p0, p1, p2] = p;
+    let mut n = (p1 - p0).cross(p2 - p0).normalize_or_zero();
+    if let Some(ns) = normals {
+        if n.dot(ns) < 0.0 {
+            n = -n;
+        }
+    }
+    if flip {
+        -n
+    } else {
+        n
+    }
+}
+
+#[derive(Clone, Debug)]
+pub struct Sphere {
+    pub center: Vec3,
+    pub radius: f32,
+    pub material: MaterialId,
+    pub light: Option<LightId>,
+    /// Normals point inwards.
+    pub flip_normals: bool,
+}
+
+/// A primitive in the BVH.
+#[derive(Clone, Copy, Debug)]
+pub enum Prim {
+    Triangle { mesh: u32, tri: u32 },
+    Sphere(u32),
+}
