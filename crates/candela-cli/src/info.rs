@@ -11,7 +11,7 @@ pub fn run(path: &Path, load: &LoadArgs) -> Result<(), UserError> {
     let desc = load.load(path)?;
     let scene = candela_core::build::build(&desc)?;
     let memory = crate::footprint::describe(&scene);
-    let s = &scene.settings;
+    let s = &desc.render;
     let b = scene.bounds();
     let count = |f: fn(&Light) -> bool| scene.lights.iter().filter(|l| f(l)).count();
     println!("scene      {}", path.display());

@@ -11,8 +11,13 @@ use std::sync::Arc;
 
 use glam::{Affine2, Mat3, Mat4, Vec2, Vec3, Vec4};
 
+use crate::options::AovSet;
+
 mod media;
 
+pub use crate::options::{
+    FilterSampling, Isa, LampSampling, LightSamplerKind, MisMode, SamplerKind,
+};
 pub use media::*;
 
 /// Where an item of a description came from: `file:line:col` (1-based). Items made in code
@@ -578,106 +583,6 @@ pub enum EnvironmentMapDesc {
     Cubemap(Box<[ImageDesc; 6]>),
 }
 
-/// How to weigh next event estimation against BSDF sampling. Its names in scene files and
-/// on the command line are `balance`, `power`, `none` and `bsdf`.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Deserialize)]
-#[serde(rename_all = "kebab-case")]
-pub enum MisMode {
-    /// Balance heuristic (Veach 1997, §9.2.2); the default, as in the course notes.
-    #[default]
-    Balance,
-    /// Power heuristic with β = 2.
-    Power,
-    /// Next event estimation only for direct light; emitters hit by BSDF-sampled rays
-    /// count only after specular bounces.
-    #[serde(rename = "none")]
-    NeeOnly,
-    /// BSDF sampling only: no shadow rays. For testing estimators against each other.
-    #[serde(rename = "bsdf")]
-    BsdfOnly,
-}
-
-/// How to pick the one light that next event estimation samples. Its names in scene files
-/// and on the command line are the variants' names in kebab case (`ris-bvh`).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Deserialize)]
-#[serde(rename_all = "kebab-case")]
-pub enum LightSamplerKind {
-    Uniform,
-    /// Proportional to emitted power, through an alias table.
-    Power,
-    /// Proportional to power through the course notes' slot array.
-    Array,
-    /// Resampled importance sampling over candidates from the array.
-    Ris,
-    /// Light BVH with orientation cones (Conty Estevez & Kulla 2018): the default, since
-    /// at equal spp it measured 0.26–0.72× `Power`'s relMSE where the choice of light
-    /// matters, 0.86× on glossy plates and the same with one light, for 1.0–1.8× the CPU
-    /// time per sample (`bench/equal_spp.sh`, bench/RESULTS.md, issue 36).
-    #[default]
-    Bvh,
-    /// Resampled importance sampling over candidates from the light BVH.
-    RisBvh,
-}
-
-/// How next event estimation draws a point on a flat lamp (an emitting triangle or
-/// rectangle without an emission texture). Its names in scene files and on the command
-/// line are `area` and `solid-angle`.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Deserialize)]
-#[serde(rename_all = "kebab-case")]
-pub enum LampSampling {
-    /// Uniformly by area, everywhere: the default, the cheaper per sample, and the more
-    /// efficient where most of the noise is indirect light (the Cornell box and a softbox
-    /// scene measured 0.93× and 0.92× as efficient with `SolidAngle`: bench/RESULTS.md,
-    /// lamp_sampling).
-    #[default]
-    Area,
-    /// Where a lamp is wider than its centre is far from the shading point, uniformly in
-    /// the solid angle it covers, warped by the receiver's cosine (Arvo's spherical
-    /// triangles, Ureña et al.'s spherical rectangles); elsewhere by area. Less noise
-    /// from large, close lamps for more time a sample (about 250 ns against 20 ns by
-    /// area): 1.66× as efficient on `scenes/plastics.toml`.
-    SolidAngle,
-}
-
-/// Where the integrator's uniform numbers come from (see [`crate::sampler`]). Its names in
-/// scene files and on the command line are `independent`, `sobol` and `sobol-cmj`.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Deserialize)]
-#[serde(rename_all = "kebab-case")]
-pub enum SamplerKind {
-    /// Independent uniform numbers (PCG32).
-    Independent,
-    /// Owen-scrambled Sobol' points, stratified within each pixel: `bench/sampler.sh`
-    /// measured 1.56× lower relMSE than independent samples at 64 spp on the 512² Cornell
-    /// box and 1.68× on the depth-of-field scene for 5–10 % more time (bench/JOURNAL.md,
-    /// "Samplers — `bench/sampler.sh`, noisy machine").
-    Sobol,
-    /// [`SamplerKind::Sobol`] except for the first bounce's BSDF direction, which comes
-    /// from a correlated multi-jittered pattern of the planned spp
-    /// ([`crate::sampler::SobolCmjSampler`]); the default, since it measured 1.135× lower
-    /// relMSE than `Sobol` on the Cornell box at 64 spp (1.025× at 16), level or better
-    /// on five other scenes, for ≈ 2.5 % more instructions in the render loop
-    /// (bench/RESULTS.md, sampler).
-    #[default]
-    SobolCmj,
-}
-
-/// Which compiled copy of the render loop runs (see [`crate::isa`]). Its names on the
-/// command line are `auto`, `baseline` and `v3`. Every choice renders the same pixels,
-/// bit for bit; only the speed differs.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Deserialize)]
-#[serde(rename_all = "kebab-case")]
-pub enum Isa {
-    /// The fastest copy the CPU runs: [`Isa::V3`] where it has x86-64-v3, else
-    /// [`Isa::Baseline`].
-    #[default]
-    Auto,
-    /// The copy compiled for the build's target (on x86-64, any x86-64 CPU).
-    Baseline,
-    /// The copy compiled for x86-64-v3 (AVX2, FMA, BMI1/2, LZCNT, MOVBE, F16C); only
-    /// on x86-64 CPUs that have them.
-    V3,
-}
-
 /// Default number of RIS candidates, chosen by `bench/many_lights`.
 pub const DEFAULT_RIS_CANDIDATES: u32 = 2;
 
@@ -715,7 +620,7 @@ pub struct RenderSettings {
     /// ([`Isa::is_supported`]).
     pub isa: Isa,
     /// Passes rendered beside the beauty image (see [`crate::aov`]).
-    pub aovs: crate::aov::AovSet,
+    pub aovs: AovSet,
 }
 
 /// The pixel reconstruction filter (see [`crate::filter`]); radii in pixels.
@@ -732,24 +637,6 @@ pub enum PixelFilterDesc {
         stddev: f32,
         radius: f32,
     },
-}
-
-/// How a pixel filter wider than a pixel (tent, Gaussian) reaches the image (see
-/// [`crate::splat`]). Its names in scene files and on the command line are `splat` and
-/// `importance`. The box filter renders the same either way.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Deserialize)]
-#[serde(rename_all = "kebab-case")]
-pub enum FilterSampling {
-    /// Each sample, uniform in its pixel, adds to every pixel under the filter, weighted by
-    /// it; each pixel divides by its weights' sum (Mitsuba's way). A pixel then averages
-    /// about as many samples as the filter covers pixels, so at equal spp its noise is
-    /// lower: the default.
-    #[default]
-    Splat,
-    /// Each sample's offset is drawn from the filter and the sample goes to its own pixel
-    /// only (filter importance sampling, Ernst et al. 2006): the same expected image, with
-    /// no sample crossing a pixel.
-    Importance,
 }
 
 impl Default for RenderSettings {
@@ -770,7 +657,7 @@ impl Default for RenderSettings {
             filter: PixelFilterDesc::Box,
             filter_sampling: FilterSampling::default(),
             isa: Isa::Auto,
-            aovs: crate::aov::AovSet::NONE,
+            aovs: AovSet::NONE,
         }
     }
 }

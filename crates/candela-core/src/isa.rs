@@ -10,7 +10,7 @@
 //! three-operand forms) and integer bit operations, not the arithmetic
 //! (`tests/isa.rs` compares the films of both).
 
-use crate::desc::Isa;
+use crate::options::Isa;
 
 /// The features of x86-64-v3 beyond the x86-64 baseline, as `#[target_feature]` and
 /// `is_x86_feature_detected!` spell them (rustc's `--print cfg -C

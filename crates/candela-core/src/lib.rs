@@ -51,6 +51,7 @@ pub mod light_sampler;
 pub mod material;
 pub mod math;
 pub mod medium;
+pub mod options;
 pub mod photometry;
 pub mod sampler;
 pub mod sampling;

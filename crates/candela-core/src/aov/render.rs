@@ -7,8 +7,8 @@ use glam::UVec2;
 use rayon::prelude::*;
 
 use super::{first_surface, AovFilm, AovPixel};
-use crate::desc::SamplerKind;
 use crate::integrator::camera_ray;
+use crate::options::SamplerKind;
 use crate::sampler::{IndependentSampler, Sampler, SobolCmjSampler, SobolSampler};
 use crate::scene::Scene;
 

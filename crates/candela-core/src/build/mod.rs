@@ -20,12 +20,13 @@ use std::sync::Arc;
 use glam::Vec3;
 
 use crate::accel::{Accel, NodeLayout, Shape, Simd};
-use crate::desc::{GeometryDesc, MeshDesc, SceneDesc, Span};
+use crate::desc::{GeometryDesc, MeshDesc, RenderSettings, SceneDesc, Span};
 use crate::geometry::Aabb;
 use crate::instance::{Instance, Instances, Transform};
 use crate::light::{Light, LightId, SphereLight};
 use crate::light_sampler::LightSampler;
 use crate::material::MaterialId;
+use crate::options::RenderOptions;
 use crate::scene::{Prim, Scene, Sphere};
 
 mod camera;
@@ -258,7 +259,7 @@ fn build_taking(desc: &SceneDesc, mut taken: Vec<Option<MeshDesc>>) -> Result<Sc
     Ok(Scene {
         camera,
         filter,
-        settings: r.clone(),
+        settings: render_options(r),
         meshes,
         spheres,
         materials,
@@ -270,4 +271,22 @@ fn build_taking(desc: &SceneDesc, mut taken: Vec<Option<MeshDesc>>) -> Result<Sc
         instances,
         media: media.finish(materials_len),
     })
+}
+
+/// What the render code reads of the settings; the rest went into the scene's objects.
+fn render_options(r: &RenderSettings) -> RenderOptions {
+    RenderOptions {
+        width: r.width,
+        height: r.height,
+        spp: r.spp,
+        max_depth: r.max_depth,
+        rr_depth: r.rr_depth,
+        seed: r.seed,
+        mis: r.mis,
+        sampler: r.sampler,
+        hide_emitters: r.hide_emitters,
+        filter_sampling: r.filter_sampling,
+        isa: r.isa,
+        aovs: r.aovs,
+    }
 }

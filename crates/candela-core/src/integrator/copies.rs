@@ -1,6 +1,6 @@
 //! The compiled copies of the render loop: one for the build's target (baseline) and,
 //! on x86-64, one for x86-64-v3 (AVX2, FMA, BMI1/2), chosen per render by
-//! [`crate::desc::Isa`] (see [`crate::isa`]). A copy is the band loop and everything it
+//! [`crate::options::Isa`] (see [`crate::isa`]). A copy is the band loop and everything it
 //! inlines; next event estimation, kept out of line, has a copy of its own for each.
 
 use glam::Vec3;
@@ -38,7 +38,7 @@ v3_fn! {
 /// Takes a work item's samples with the render loop's copy `isa`, which the CPU must run.
 pub(crate) fn render_band<S: Sampler, K: SampleSink>(
     scene: &Scene,
-    isa: crate::desc::Isa,
+    isa: crate::options::Isa,
     sampler: &mut S,
     band: Band,
     sink: &mut K,
@@ -47,7 +47,7 @@ pub(crate) fn render_band<S: Sampler, K: SampleSink>(
     match isa {
         // SAFETY: `render_with` asserted that the CPU has the resolved ISA.
         #[cfg(target_arch = "x86_64")]
-        crate::desc::Isa::V3 => unsafe { render_pixels_v3(scene, sampler, band, sink) },
+        crate::options::Isa::V3 => unsafe { render_pixels_v3(scene, sampler, band, sink) },
         _ => render_pixels::<S, K, false>(scene, sampler, band, sink),
     }
 }

@@ -5,9 +5,9 @@
 use glam::{Vec2, Vec3};
 
 use crate::bsdf::Bsdf;
-use crate::desc::MisMode;
 use crate::light::{Light, LightSample, LightSource, ShadingCtx};
 use crate::light_sampler::LightPick;
+use crate::options::MisMode;
 use crate::sampling::{balance_heuristic, power_heuristic};
 use crate::scene::{Scene, SurfaceInteraction};
 

@@ -16,8 +16,8 @@
 use std::ops::Range;
 use std::sync::atomic::AtomicBool;
 
-use crate::desc::SamplerKind;
 use crate::film::Film;
+use crate::options::SamplerKind;
 use crate::sampler::{IndependentSampler, SobolCmjSampler, SobolSampler};
 use crate::scene::Scene;
 

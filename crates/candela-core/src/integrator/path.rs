@@ -9,10 +9,10 @@ use super::copies::sample_direct_baseline;
 use super::copies::sample_direct_v3;
 use super::direct::{mis_weight, NeeVertex};
 use super::volpath;
-use crate::desc::MisMode;
 use crate::geometry::Ray;
 use crate::light::{LightId, ShadingCtx};
 use crate::math::max_component;
+use crate::options::MisMode;
 use crate::sampler::Sampler;
 use crate::scene::Scene;
 

@@ -12,9 +12,9 @@ use rayon::prelude::*;
 use super::band::{Band, SampleSink};
 use super::copies::render_band;
 use super::{RenderResult, RenderStats};
-use crate::desc::FilterSampling;
 use crate::film::{Film, Pixel};
 use crate::filter::PixelFilter;
+use crate::options::FilterSampling;
 use crate::sampler::Sampler;
 use crate::scene::Scene;
 
@@ -22,7 +22,7 @@ use crate::scene::Scene;
 const BAND_ROWS: usize = 4;
 
 /// [`super::render`] with a given sampler, monomorphized so that no sample is a dynamic call.
-/// The scene's [`crate::desc::Isa`] chooses the compiled copy of the render loop.
+/// The scene's [`crate::options::Isa`] chooses the compiled copy of the render loop.
 pub fn render_with<S: Sampler>(
     scene: &Scene,
     sampler: S,
@@ -97,7 +97,7 @@ pub fn render_with<S: Sampler>(
 pub(crate) struct PassCtx<'a> {
     pub scene: &'a Scene,
     /// The resolved copy of the render loop (supported by the CPU).
-    pub isa: crate::desc::Isa,
+    pub isa: crate::options::Isa,
     pub cancel: &'a AtomicBool,
     pub progress: &'a (dyn Fn(u64) + Sync),
 }

@@ -253,7 +253,7 @@ pub(crate) fn li<S: Sampler>(
 /// Russian roulette on the path's throughput (as the path tracer plays it, on the
 /// throughput divided by the mean channel density); false where the path ends.
 fn roulette<S: Sampler>(
-    settings: &crate::desc::RenderSettings,
+    settings: &crate::options::RenderOptions,
     path: &mut Path,
     eta_scale: f32,
     depth: u32,

@@ -49,9 +49,9 @@ pub use triangle::TriangleLight;
 
 use glam::{Vec2, Vec3};
 
-use crate::desc::LampSampling;
 use crate::geometry::Ray;
 use crate::math::luminance;
+use crate::options::LampSampling;
 
 /// Index of a light in [`crate::Scene::lights`].
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]

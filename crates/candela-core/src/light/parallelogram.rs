@@ -6,9 +6,9 @@ use super::triangle::solid_angle;
 use super::{
     flat_importance, LightBounds, LightFlags, LightSample, LightSource, ShadingCtx, TriangleLight,
 };
-use crate::desc::LampSampling;
 use crate::geometry::Aabb;
 use crate::math::luminance;
+use crate::options::LampSampling;
 
 /// An emitting parallelogram p₀ + a·e₁ + b·e₂, (a, b) ∈ [0, 1]²: the two triangles of an
 /// emitting quad (a rectangle light, the Cornell box's lamp) made one light at build time

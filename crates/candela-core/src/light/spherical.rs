@@ -560,7 +560,7 @@ mod tests {
     #[test]
     fn random_lamps_and_points_give_finite_consistent_samples() {
         use super::super::{Light, ParallelogramLight, TriangleLight};
-        use crate::desc::LampSampling;
+        use crate::options::LampSampling;
         let mut rng = Pcg32::new(31, 7);
         let mut r = move || rng.uniform_f32();
         let (mut samples, mut checked, mut disagree, mut spherical) = (0, 0, 0, 0);

@@ -7,10 +7,10 @@ use super::{
     flat_importance, positive_finite, EmissionTexture, LightBounds, LightFlags, LightProfile,
     LightSample, LightSource, ShadingCtx,
 };
-use crate::desc::LampSampling;
 use crate::geometry::Aabb;
 use crate::geometry::{Ray, WatertightRay};
 use crate::math::luminance;
+use crate::options::LampSampling;
 use crate::sampling::sample_uniform_triangle;
 
 /// One emitting triangle of a mesh. Emits `le` on the side its normal `n` points to.

@@ -22,8 +22,8 @@ pub use array::LightArray;
 pub use bvh::LightBvh;
 pub use ris::Ris;
 
-use crate::desc::LightSamplerKind;
 use crate::light::{Light, LightId, ShadingCtx};
+use crate::options::LightSamplerKind;
 use crate::sampling::AliasTable;
 
 /// A light chosen for next event estimation.

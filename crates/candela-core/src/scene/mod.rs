@@ -9,7 +9,6 @@ use glam::{Vec2, Vec3};
 
 use crate::accel::Accel;
 use crate::camera::Camera;
-use crate::desc::RenderSettings;
 use crate::filter::PixelFilter;
 use crate::geometry::{Aabb, Ray};
 use crate::instance::Instances;
@@ -17,6 +16,7 @@ use crate::light::{Light, LightId};
 use crate::light_sampler::LightSampler;
 use crate::material::Material;
 use crate::math::offset_ray_origin;
+use crate::options::RenderOptions;
 
 mod interaction;
 mod mesh;
@@ -30,7 +30,7 @@ pub use mesh::{Mesh, Prim, Sphere};
 pub struct Scene {
     pub camera: Camera,
     pub filter: PixelFilter,
-    pub settings: RenderSettings,
+    pub settings: RenderOptions,
     pub meshes: Vec<Mesh>,
     pub spheres: Vec<Sphere>,
     pub materials: Vec<Material>,
