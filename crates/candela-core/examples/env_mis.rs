@@ -52,21 +52,9 @@ fn sky(w: u32, h: u32) -> ImageDesc {
 }
 
 fn scene(width: u32, height: u32) -> SceneDesc {
-    let mat = |name: &str, albedo: Vec3| MaterialDesc {
-        name: name.into(),
-        bsdf: BsdfDesc::Diffuse {
-            albedo: TextureDesc::Constant(albedo),
-        },
-        span: Span::code(),
-    };
-    let shape = |geometry, material: &str, transform| ShapeDesc {
-        geometry,
-        material: material.into(),
-        emission: None,
-        emission_texture: None,
-        transform,
-        flip_normals: false,
-        span: Span::code(),
+    let mat = |name: &str, albedo: Vec3| MaterialDesc::diffuse(name, albedo);
+    let shape = |geometry, material: &str, transform| {
+        ShapeDesc::new(geometry, material).transformed(transform)
     };
     let sphere = |x: f32, r: f32, m: &str| {
         shape(

@@ -68,13 +68,8 @@ fn main() {
 
     let mesh = Arc::new(bumpy_sphere(m));
     let mut desc = SceneDesc::default();
-    desc.materials.push(MaterialDesc {
-        name: "white".into(),
-        bsdf: BsdfDesc::Diffuse {
-            albedo: TextureDesc::Constant(Vec3::splat(0.5)),
-        },
-        span: Span::code(),
-    });
+    desc.materials
+        .push(MaterialDesc::diffuse("white", Vec3::splat(0.5)));
     let side = (n as f64).sqrt().ceil() as usize;
     for k in 0..n {
         let (x, z) = ((k % side) as f32 * 3.0, (k / side) as f32 * 3.0);
@@ -83,19 +78,14 @@ fn main() {
         } else {
             mesh.clone()
         };
-        desc.shapes.push(ShapeDesc {
-            geometry: GeometryDesc::Mesh(geometry),
-            material: "white".into(),
-            emission: None,
-            emission_texture: None,
-            transform: Mat4::from_scale_rotation_translation(
-                Vec3::splat(1.0 + 0.2 * (k % 3) as f32),
-                Quat::from_rotation_y(k as f32),
-                Vec3::new(x, 0.0, z),
-            ),
-            flip_normals: false,
-            span: Span::code(),
-        });
+        desc.shapes
+            .push(ShapeDesc::mesh(geometry, "white").transformed(
+                Mat4::from_scale_rotation_translation(
+                    Vec3::splat(1.0 + 0.2 * (k % 3) as f32),
+                    Quat::from_rotation_y(k as f32),
+                    Vec3::new(x, 0.0, z),
+                ),
+            ));
     }
     let before = peak_rss_mb();
     let t0 = Instant::now();

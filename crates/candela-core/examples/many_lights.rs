@@ -96,25 +96,14 @@ fn build_cost() {
 }
 
 fn material(d: &mut SceneDesc) {
-    d.materials.push(MaterialDesc {
-        name: "white".into(),
-        bsdf: BsdfDesc::Diffuse {
-            albedo: TextureDesc::Constant(Vec3::splat(0.6)),
-        },
-        span: Span::code(),
-    });
+    d.materials
+        .push(MaterialDesc::diffuse("white", Vec3::splat(0.6)));
 }
 
 fn shape(geometry: GeometryDesc, transform: Mat4, emission: Option<Vec3>) -> ShapeDesc {
-    ShapeDesc {
-        geometry,
-        material: "white".into(),
-        emission,
-        emission_texture: None,
-        transform,
-        flip_normals: false,
-        span: Span::code(),
-    }
+    ShapeDesc::new(geometry, "white")
+        .transformed(transform)
+        .with_emission(emission)
 }
 
 /// A downward-facing quad of half-size `h` at `c` (two triangle lights).

@@ -13,6 +13,7 @@ use glam::{Affine2, Mat3, Mat4, Vec2, Vec3, Vec4};
 
 use crate::options::AovSet;
 
+mod builders;
 mod media;
 
 pub use crate::options::{

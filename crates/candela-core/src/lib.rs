@@ -4,25 +4,13 @@
 //!
 //! ```
 //! use candela_core::desc::*;
-//! use glam::{Mat4, Vec3};
+//! use glam::Vec3;
 //! use std::sync::atomic::AtomicBool;
 //!
 //! let mut desc = SceneDesc::default();
 //! desc.render = RenderSettings { width: 8, height: 8, spp: 4, ..Default::default() };
-//! desc.materials.push(MaterialDesc {
-//!     name: "white".into(),
-//!     bsdf: BsdfDesc::Diffuse { albedo: TextureDesc::Constant(Vec3::splat(0.8)) },
-//!     span: Span::code(),
-//! });
-//! desc.shapes.push(ShapeDesc {
-//!     geometry: GeometryDesc::Sphere { center: Vec3::ZERO, radius: 1.0 },
-//!     material: "white".into(),
-//!     emission: Some(Vec3::ONE),
-//!     emission_texture: None,
-//!     transform: Mat4::IDENTITY,
-//!     flip_normals: false,
-//!     span: Span::code(),
-//! });
+//! desc.materials.push(MaterialDesc::diffuse("white", Vec3::splat(0.8)));
+//! desc.shapes.push(ShapeDesc::sphere(Vec3::ZERO, 1.0, "white").emitting(Vec3::ONE));
 //! let scene = candela_core::build::build(&desc).unwrap();
 //! let result = candela_core::integrator::render(&scene, 0..4, &AtomicBool::new(false), &|_| {});
 //! assert_eq!(result.film.resolve()[4 * 8 + 4], Vec3::ONE); // the centre pixel sees the sphere

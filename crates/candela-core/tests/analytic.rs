@@ -39,25 +39,13 @@ const SAMPLERS: [SamplerKind; 3] = [
 ];
 
 fn material(name: &str, albedo: f32) -> MaterialDesc {
-    MaterialDesc {
-        name: name.into(),
-        bsdf: BsdfDesc::Diffuse {
-            albedo: TextureDesc::Constant(Vec3::splat(albedo)),
-        },
-        span: Span::code(),
-    }
+    MaterialDesc::diffuse(name, Vec3::splat(albedo))
 }
 
 fn shape(geometry: GeometryDesc, material: &str, le: Option<f32>, flip: bool) -> ShapeDesc {
-    ShapeDesc {
-        geometry,
-        material: material.into(),
-        emission: le.map(Vec3::splat),
-        emission_texture: None,
-        transform: Mat4::IDENTITY,
-        flip_normals: flip,
-        span: Span::code(),
-    }
+    ShapeDesc::new(geometry, material)
+        .with_emission(le.map(Vec3::splat))
+        .with_flipped_normals(flip)
 }
 
 fn settings(
@@ -370,11 +358,9 @@ fn narrow_camera(target: Vec3, offset: Vec3) -> CameraDesc {
 
 /// The plane y = 0, 20 × 20 around the origin, facing +y.
 fn floor_plane(material: &str) -> ShapeDesc {
-    ShapeDesc {
-        transform: Mat4::from_rotation_x(-std::f32::consts::FRAC_PI_2)
-            * Mat4::from_scale(Vec3::splat(10.0)),
-        ..shape(GeometryDesc::Rectangle, material, None, false)
-    }
+    shape(GeometryDesc::Rectangle, material, None, false).transformed(
+        Mat4::from_rotation_x(-std::f32::consts::FRAC_PI_2) * Mat4::from_scale(Vec3::splat(10.0)),
+    )
 }
 
 /// Radiance of a diffuse plane y = 0 (albedo ρ) at `target` on it, lit by a point light
@@ -398,13 +384,10 @@ fn plane_radiance(
     };
     desc.materials.push(material("plane", rho));
     desc.shapes.push(floor_plane("plane"));
-    desc.lights.push(LightDesc {
-        kind: LightKindDesc::Point {
-            position: Vec3::new(0.0, h, 0.0),
-            intensity: Vec3::splat(intensity),
-        },
-        span: Span::code(),
-    });
+    desc.lights.push(LightDesc::point(
+        Vec3::new(0.0, h, 0.0),
+        Vec3::splat(intensity),
+    ));
     let px = render_pixels(&desc);
     px.iter().sum::<f64>() / px.len() as f64
 }
@@ -457,11 +440,12 @@ fn an_orthographic_camera_sees_true_sizes_at_any_distance() {
                 ..Default::default()
             };
             desc.materials.push(material("black", 0.0));
-            desc.shapes.push(ShapeDesc {
-                transform: Mat4::from_rotation_x(-std::f32::consts::FRAC_PI_2)
-                    * Mat4::from_scale(Vec3::splat(0.5)),
-                ..shape(GeometryDesc::Rectangle, "black", Some(1.0), false)
-            });
+            desc.shapes.push(
+                shape(GeometryDesc::Rectangle, "black", Some(1.0), false).transformed(
+                    Mat4::from_rotation_x(-std::f32::consts::FRAC_PI_2)
+                        * Mat4::from_scale(Vec3::splat(0.5)),
+                ),
+            );
             let px = render_pixels(&desc);
             let side = 32;
             for (i, v) in px.iter().enumerate() {
@@ -530,17 +514,19 @@ fn a_checkered_emitter_lights_a_plane_square_by_square() {
         desc.materials.push(material("plane", rho));
         desc.materials.push(material("black", 0.0));
         desc.shapes.push(floor_plane("plane"));
-        desc.shapes.push(ShapeDesc {
-            transform: Mat4::from_translation(Vec3::new(0.0, h, 0.0))
-                * Mat4::from_rotation_x(std::f32::consts::FRAC_PI_2)
-                * Mat4::from_scale(Vec3::splat(s)),
-            emission_texture: Some(TextureDesc::Checker {
-                a: Vec3::splat(hi),
-                b: Vec3::splat(lo),
-                uv_transform: glam::Affine2::from_scale(glam::Vec2::splat(2.0)),
-            }),
-            ..shape(GeometryDesc::Rectangle, "black", Some(1.0), false)
-        });
+        desc.shapes.push(
+            shape(GeometryDesc::Rectangle, "black", Some(1.0), false)
+                .transformed(
+                    Mat4::from_translation(Vec3::new(0.0, h, 0.0))
+                        * Mat4::from_rotation_x(std::f32::consts::FRAC_PI_2)
+                        * Mat4::from_scale(Vec3::splat(s)),
+                )
+                .with_emission_texture(TextureDesc::Checker {
+                    a: Vec3::splat(hi),
+                    b: Vec3::splat(lo),
+                    uv_transform: glam::Affine2::from_scale(glam::Vec2::splat(2.0)),
+                }),
+        );
         let px = render_pixels(&desc);
         check_uniform(
             &format!("checkered emitter, {mis:?}, {sampler:?}"),
@@ -607,10 +593,8 @@ fn near_lamps_light_a_plane_as_lamberts_formula_says() {
                 desc.materials.push(material("plane", rho));
                 desc.materials.push(material("black", 0.0));
                 desc.shapes.push(floor_plane("plane"));
-                desc.shapes.push(ShapeDesc {
-                    transform,
-                    ..shape(geometry.clone(), "black", Some(le), false)
-                });
+                desc.shapes
+                    .push(shape(geometry.clone(), "black", Some(le), false).transformed(transform));
                 let px = render_pixels(&desc);
                 let name = format!("near {what}, {lamp_sampling:?}, {mis:?}, {sampler:?}");
                 check_uniform(&name, &px, expected, true);

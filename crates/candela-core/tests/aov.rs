@@ -19,25 +19,11 @@ const RHO: Vec3 = Vec3::new(0.7, 0.5, 0.2);
 const SIZE: u32 = 16;
 
 fn diffuse(name: &str, albedo: Vec3) -> MaterialDesc {
-    MaterialDesc {
-        name: name.into(),
-        bsdf: BsdfDesc::Diffuse {
-            albedo: TextureDesc::Constant(albedo),
-        },
-        span: Span::code(),
-    }
+    MaterialDesc::diffuse(name, albedo)
 }
 
 fn shape(geometry: GeometryDesc, material: &str, transform: Mat4) -> ShapeDesc {
-    ShapeDesc {
-        geometry,
-        material: material.into(),
-        emission: None,
-        emission_texture: None,
-        transform,
-        flip_normals: false,
-        span: Span::code(),
-    }
+    ShapeDesc::new(geometry, material).transformed(transform)
 }
 
 /// A scene seen from (0, 0, 5) towards the origin, `fov` degrees vertically.
@@ -103,9 +89,9 @@ fn albedo_of_a_diffuse_wall_is_its_reflectance() {
 /// mirror's depth.
 #[test]
 fn albedo_through_a_mirror_is_the_reflected_walls() {
-    let mirror = MaterialDesc {
-        name: "mirror".into(),
-        bsdf: BsdfDesc::Conductor {
+    let mirror = MaterialDesc::new(
+        "mirror",
+        BsdfDesc::Conductor {
             eta: Vec3::ONE,
             k: Vec3::splat(1000.0),
             specular: Vec3::ONE,
@@ -113,8 +99,7 @@ fn albedo_through_a_mirror_is_the_reflected_walls() {
             alpha_v: 0.0,
             distribution: MicrofacetDesc::default(),
         },
-        span: Span::code(),
-    };
+    );
     // Normal (0, 1, 1)/√2: the camera's −z turns into +y.
     let mirror_shape = shape(
         GeometryDesc::Rectangle,
@@ -153,9 +138,9 @@ fn albedo_through_a_mirror_is_the_reflected_walls() {
 /// the ball or beside it, has the albedo of the diffuse surfaces.
 #[test]
 fn albedo_through_glass_is_the_surroundings() {
-    let glass = MaterialDesc {
-        name: "glass".into(),
-        bsdf: BsdfDesc::Dielectric {
+    let glass = MaterialDesc::new(
+        "glass",
+        BsdfDesc::Dielectric {
             eta: 1.5,
             alpha_u: 0.0,
             alpha_v: 0.0,
@@ -163,8 +148,7 @@ fn albedo_through_glass_is_the_surroundings() {
             thin: false,
             tint: TextureDesc::Constant(Vec3::ONE),
         },
-        span: Span::code(),
-    };
+    );
     let ball = shape(
         GeometryDesc::Sphere {
             center: Vec3::ZERO,

@@ -13,25 +13,13 @@ use glam::{Mat4, Quat, Vec2, Vec3};
 const FOV: f32 = 40.0;
 
 fn black_material() -> MaterialDesc {
-    MaterialDesc {
-        name: "black".into(),
-        bsdf: BsdfDesc::Diffuse {
-            albedo: TextureDesc::Constant(Vec3::ZERO),
-        },
-        span: Span::code(),
-    }
+    MaterialDesc::diffuse("black", Vec3::ZERO)
 }
 
 fn shape(geometry: GeometryDesc, material: &str, le: Option<f32>, transform: Mat4) -> ShapeDesc {
-    ShapeDesc {
-        geometry,
-        material: material.into(),
-        emission: le.map(Vec3::splat),
-        emission_texture: None,
-        transform,
-        flip_normals: false,
-        span: Span::code(),
-    }
+    ShapeDesc::new(geometry, material)
+        .transformed(transform)
+        .with_emission(le.map(Vec3::splat))
 }
 
 fn camera(lens: Option<LensDesc>) -> CameraDesc {
@@ -279,13 +267,8 @@ fn flat_scene(lens: Option<LensDesc>, seed: u64) -> SceneDesc {
         ..Default::default()
     };
     desc.materials.push(black_material());
-    desc.materials.push(MaterialDesc {
-        name: "grey".into(),
-        bsdf: BsdfDesc::Diffuse {
-            albedo: TextureDesc::Constant(Vec3::splat(0.7)),
-        },
-        span: Span::code(),
-    });
+    desc.materials
+        .push(MaterialDesc::diffuse("grey", Vec3::splat(0.7)));
     let backdrop =
         Mat4::from_translation(Vec3::new(0.0, 0.0, -3.0)) * Mat4::from_scale(Vec3::splat(2.0));
     desc.shapes
@@ -299,13 +282,10 @@ fn flat_scene(lens: Option<LensDesc>, seed: u64) -> SceneDesc {
         desc.shapes
             .push(shape(GeometryDesc::Rectangle, "black", Some(le), t));
     }
-    desc.lights.push(LightDesc {
-        kind: LightKindDesc::Point {
-            position: Vec3::new(0.5, 0.8, -1.0),
-            intensity: Vec3::splat(2.0),
-        },
-        span: Span::code(),
-    });
+    desc.lights.push(LightDesc::point(
+        Vec3::new(0.5, 0.8, -1.0),
+        Vec3::splat(2.0),
+    ));
     desc
 }
 

@@ -13,40 +13,19 @@ use candela_core::Scene;
 use glam::{Mat3, Mat4, UVec2, Vec2, Vec3};
 
 fn material(name: &str, albedo: Vec3) -> MaterialDesc {
-    MaterialDesc {
-        name: name.into(),
-        bsdf: BsdfDesc::Diffuse {
-            albedo: TextureDesc::Constant(albedo),
-        },
-        span: Span::code(),
-    }
+    MaterialDesc::diffuse(name, albedo)
 }
 
 fn sphere(center: Vec3, radius: f32, material: &str) -> ShapeDesc {
-    ShapeDesc {
-        geometry: GeometryDesc::Sphere { center, radius },
-        material: material.into(),
-        emission: None,
-        emission_texture: None,
-        transform: Mat4::IDENTITY,
-        flip_normals: false,
-        span: Span::code(),
-    }
+    ShapeDesc::sphere(center, radius, material)
 }
 
 /// A 20 × 20 square in the plane y = 0, facing +y. (Much larger squares lose about 1% of
 /// grazing rays to self-intersection: the hit point's error grows with the vertices'
 /// magnitude, the ray offset only with the point's.)
 fn ground(material: &str) -> ShapeDesc {
-    ShapeDesc {
-        geometry: GeometryDesc::Rectangle,
-        material: material.into(),
-        emission: None,
-        emission_texture: None,
-        transform: Mat4::from_rotation_x(-PI / 2.0) * Mat4::from_scale(Vec3::splat(10.0)),
-        flip_normals: false,
-        span: Span::code(),
-    }
+    ShapeDesc::new(GeometryDesc::Rectangle, material)
+        .transformed(Mat4::from_rotation_x(-PI / 2.0) * Mat4::from_scale(Vec3::splat(10.0)))
 }
 
 fn build(
@@ -307,13 +286,10 @@ fn environment_power_follows_scene_size_and_drives_light_selection() {
         },
         ..Default::default()
     };
-    desc.lights.push(LightDesc {
-        kind: LightKindDesc::Point {
-            position: Vec3::new(0.0, 2.0, 0.0),
-            intensity: Vec3::splat(10.0),
-        },
-        span: Span::code(),
-    });
+    desc.lights.push(LightDesc::point(
+        Vec3::new(0.0, 2.0, 0.0),
+        Vec3::splat(10.0),
+    ));
     let scene = candela_core::build::build(&desc).unwrap();
     let powers: Vec<f32> = scene.lights.iter().map(|l| l.power()).collect();
     let ctx = candela_core::light::ShadingCtx {

@@ -35,15 +35,9 @@ const GAUSSIAN: PixelFilterDesc = PixelFilterDesc::Gaussian {
 const TENT: PixelFilterDesc = PixelFilterDesc::Tent { radius: 1.5 };
 
 fn shape(geometry: GeometryDesc, material: &str, emission: Option<Vec3>, t: Mat4) -> ShapeDesc {
-    ShapeDesc {
-        geometry,
-        material: material.into(),
-        emission,
-        emission_texture: None,
-        transform: t,
-        flip_normals: false,
-        span: Span::code(),
-    }
+    ShapeDesc::new(geometry, material)
+        .transformed(t)
+        .with_emission(emission)
 }
 
 /// Small bright spheres seen directly (edges a pixel sharp) over a diffuse sphere and
@@ -66,13 +60,8 @@ fn scene(filter: PixelFilterDesc, sampling: FilterSampling, light_scale: f32) ->
         }),
         ..Default::default()
     };
-    desc.materials.push(MaterialDesc {
-        name: "white".into(),
-        bsdf: BsdfDesc::Diffuse {
-            albedo: TextureDesc::Constant(Vec3::new(0.8, 0.6, 0.4)),
-        },
-        span: Span::code(),
-    });
+    desc.materials
+        .push(MaterialDesc::diffuse("white", Vec3::new(0.8, 0.6, 0.4)));
     let sphere = |center, radius| GeometryDesc::Sphere { center, radius };
     desc.shapes.push(shape(
         sphere(Vec3::new(0.0, -0.3, 0.0), 0.9),

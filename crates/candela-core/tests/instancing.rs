@@ -101,13 +101,8 @@ fn base_desc() -> SceneDesc {
         },
         ..Default::default()
     };
-    desc.materials.push(MaterialDesc {
-        name: "white".into(),
-        bsdf: BsdfDesc::Diffuse {
-            albedo: TextureDesc::Constant(Vec3::splat(0.7)),
-        },
-        span: Span::code(),
-    });
+    desc.materials
+        .push(MaterialDesc::diffuse("white", Vec3::splat(0.7)));
     desc
 }
 
@@ -123,15 +118,11 @@ fn scene_pair(mesh: &MeshDesc, transforms: &[Mat4], base: &SceneDesc) -> (Scene,
             } else {
                 Arc::new(mesh.clone())
             };
-            desc.shapes.push(ShapeDesc {
-                geometry: GeometryDesc::Mesh(geometry),
-                material: "white".into(),
-                emission: None,
-                emission_texture: None,
-                transform,
-                flip_normals: k % 4 == 1,
-                span: Span::code(),
-            });
+            desc.shapes.push(
+                ShapeDesc::mesh(geometry, "white")
+                    .transformed(transform)
+                    .with_flipped_normals(k % 4 == 1),
+            );
         }
         Some(candela_core::build::build(&desc).unwrap())
     });
@@ -298,15 +289,11 @@ fn single_and_emitting_meshes_stay_flattened() {
         .into_iter()
         .enumerate()
     {
-        desc.shapes.push(ShapeDesc {
-            geometry: GeometryDesc::Mesh(mesh.clone()),
-            material: "white".into(),
-            emission,
-            emission_texture: None,
-            transform: Mat4::from_translation(Vec3::X * 3.0 * k as f32),
-            flip_normals: false,
-            span: Span::code(),
-        });
+        desc.shapes.push(
+            ShapeDesc::mesh(mesh.clone(), "white")
+                .transformed(Mat4::from_translation(Vec3::X * 3.0 * k as f32))
+                .with_emission(emission),
+        );
     }
     let scene = candela_core::build::build(&desc).unwrap();
     assert!(scene.instances.is_empty());
@@ -357,15 +344,12 @@ fn instanced_render_matches_flattened_render() {
             Mat4::from_translation(Vec3::new(0.0, 0.0, -3.0)) * Mat4::from_scale(Vec3::splat(20.0)),
         ),
     ] {
-        base.shapes.push(ShapeDesc {
-            geometry: GeometryDesc::Rectangle,
-            material: "white".into(),
-            emission,
-            emission_texture: None,
-            transform,
-            flip_normals: emission.is_some(),
-            span: Span::code(),
-        });
+        base.shapes.push(
+            ShapeDesc::new(GeometryDesc::Rectangle, "white")
+                .transformed(transform)
+                .with_emission(emission)
+                .with_flipped_normals(emission.is_some()),
+        );
     }
     let (inst, flat) = scene_pair(&mesh, &transforms, &base);
     assert_eq!(inst.instances.instances.len(), 9);

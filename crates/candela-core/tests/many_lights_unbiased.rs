@@ -35,21 +35,12 @@ fn scene(kind: LightSamplerKind, mis: MisMode, seed: u64) -> candela_core::Scene
         fov_y_deg: 60.0,
         ..Default::default()
     };
-    d.materials.push(MaterialDesc {
-        name: "white".into(),
-        bsdf: BsdfDesc::Diffuse {
-            albedo: TextureDesc::Constant(Vec3::splat(0.7)),
-        },
-        span: Span::code(),
-    });
-    let shape = |geometry, transform, emission| ShapeDesc {
-        geometry,
-        material: "white".into(),
-        emission,
-        emission_texture: None,
-        transform,
-        flip_normals: false,
-        span: Span::code(),
+    d.materials
+        .push(MaterialDesc::diffuse("white", Vec3::splat(0.7)));
+    let shape = |geometry, transform, emission| {
+        ShapeDesc::new(geometry, "white")
+            .transformed(transform)
+            .with_emission(emission)
     };
     // Floor, and two boxes that cast shadows.
     d.shapes.push(shape(
@@ -82,14 +73,14 @@ fn scene(kind: LightSamplerKind, mis: MisMode, seed: u64) -> candela_core::Scene
                     ..Default::default()
                 };
                 // Wound so that the normal faces down (towards the floor) for most.
-                d.shapes.push(ShapeDesc {
-                    flip_normals: u() < 0.8,
-                    ..shape(
+                d.shapes.push(
+                    shape(
                         GeometryDesc::Mesh(Arc::new(mesh)),
                         Mat4::IDENTITY,
                         Some(color * 2.0),
                     )
-                });
+                    .with_flipped_normals(u() < 0.8),
+                );
             }
             1 => d.shapes.push(shape(
                 GeometryDesc::Sphere {
@@ -99,13 +90,7 @@ fn scene(kind: LightSamplerKind, mis: MisMode, seed: u64) -> candela_core::Scene
                 Mat4::IDENTITY,
                 Some(color * 10.0),
             )),
-            _ => d.lights.push(LightDesc {
-                kind: LightKindDesc::Point {
-                    position: c,
-                    intensity: color,
-                },
-                span: Span::code(),
-            }),
+            _ => d.lights.push(LightDesc::point(c, color)),
         }
     }
     let s = candela_core::build::build(&d).unwrap();

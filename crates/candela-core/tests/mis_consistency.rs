@@ -18,7 +18,7 @@ use std::sync::Arc;
 use candela_core::build::build;
 use candela_core::desc::*;
 use candela_core::integrator::render;
-use glam::{Mat4, Vec3};
+use glam::Vec3;
 
 mod tile_welch;
 use tile_welch::push_tile_means;
@@ -80,28 +80,22 @@ fn cornell(mis: MisMode, light_scale: f32) -> SceneDesc {
         ("green", Vec3::new(0.14, 0.45, 0.091)),
         ("light", Vec3::new(0.725, 0.71, 0.68)),
     ] {
-        desc.materials.push(MaterialDesc {
-            name: name.into(),
-            bsdf: BsdfDesc::Diffuse {
-                albedo: TextureDesc::Constant(albedo),
-            },
-            span: Span::code(),
-        });
+        desc.materials.push(MaterialDesc::diffuse(name, albedo));
     }
     for (material, q) in &quads {
-        desc.shapes.push(ShapeDesc {
-            geometry: GeometryDesc::Mesh(Arc::new(MeshDesc {
-                positions: q.iter().map(|&p| Vec3::from_array(p)).collect(),
-                indices: vec![[0, 1, 2], [0, 2, 3]],
-                ..Default::default()
-            })),
-            material: material.to_string(),
-            emission: (*material == "light").then(|| Vec3::new(17.0, 12.0, 4.0) * light_scale),
-            emission_texture: None,
-            transform: Mat4::IDENTITY,
-            flip_normals: false,
-            span: Span::code(),
-        });
+        desc.shapes.push(
+            ShapeDesc::mesh(
+                Arc::new(MeshDesc {
+                    positions: q.iter().map(|&p| Vec3::from_array(p)).collect(),
+                    indices: vec![[0, 1, 2], [0, 2, 3]],
+                    ..Default::default()
+                }),
+                *material,
+            )
+            .with_emission(
+                (*material == "light").then(|| Vec3::new(17.0, 12.0, 4.0) * light_scale),
+            ),
+        );
     }
     desc
 }

@@ -45,32 +45,19 @@ fn plane_scene(lights: Vec<LightDesc>) -> Scene {
         },
         ..Default::default()
     };
-    desc.materials.push(MaterialDesc {
-        name: "wall".into(),
-        bsdf: BsdfDesc::Diffuse {
-            albedo: TextureDesc::Constant(Vec3::splat(RHO)),
-        },
-        span: Span::code(),
-    });
+    desc.materials
+        .push(MaterialDesc::diffuse("wall", Vec3::splat(RHO)));
     // The floor y = 0, 20 × 20, facing +y.
-    desc.shapes.push(ShapeDesc {
-        geometry: GeometryDesc::Rectangle,
-        material: "wall".into(),
-        emission: None,
-        emission_texture: None,
-        transform: Mat4::from_rotation_x(-PI / 2.0) * Mat4::from_scale(Vec3::splat(10.0)),
-        flip_normals: false,
-        span: Span::code(),
-    });
+    desc.shapes.push(
+        ShapeDesc::new(GeometryDesc::Rectangle, "wall")
+            .transformed(Mat4::from_rotation_x(-PI / 2.0) * Mat4::from_scale(Vec3::splat(10.0))),
+    );
     desc.lights = lights;
     build(&desc).unwrap()
 }
 
 fn light(kind: LightKindDesc) -> LightDesc {
-    LightDesc {
-        kind,
-        span: Span::code(),
-    }
+    LightDesc::new(kind)
 }
 
 /// Radiance the path tracer sees at floor point `p` from straight above it.

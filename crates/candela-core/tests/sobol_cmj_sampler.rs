@@ -24,7 +24,7 @@ use candela_core::integrator::render;
 use candela_core::sampler::{
     first_direction_dimension, IndependentSampler, Sampler, SobolCmjSampler, SobolSampler,
 };
-use glam::{Mat4, UVec2, Vec2, Vec3};
+use glam::{UVec2, Vec2, Vec3};
 use sampler_checks::{chi2_over_pixels, one_per_cell, strata, Request};
 
 /// The first bounce's BSDF direction of a pixel sample, reached through the requests the
@@ -253,13 +253,8 @@ fn lamp_over_floor(lens: bool) -> SceneDesc {
         },
         ..Default::default()
     };
-    desc.materials.push(MaterialDesc {
-        name: "white".into(),
-        bsdf: BsdfDesc::Diffuse {
-            albedo: TextureDesc::Constant(Vec3::splat(0.7)),
-        },
-        span: Span::code(),
-    });
+    desc.materials
+        .push(MaterialDesc::diffuse("white", Vec3::splat(0.7)));
     for (corners, emission) in [
         (
             [
@@ -280,15 +275,8 @@ fn lamp_over_floor(lens: bool) -> SceneDesc {
             Some(Vec3::splat(5.0)),
         ),
     ] {
-        desc.shapes.push(ShapeDesc {
-            geometry: quad(corners),
-            material: "white".into(),
-            emission,
-            emission_texture: None,
-            transform: Mat4::IDENTITY,
-            flip_normals: false,
-            span: Span::code(),
-        });
+        desc.shapes
+            .push(ShapeDesc::new(quad(corners), "white").with_emission(emission));
     }
     desc
 }
