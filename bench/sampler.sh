@@ -3,11 +3,11 @@
 # Usage: bench/sampler.sh [--downscale N] [--spp 4,16,64] [--seeds N] [--ref-spp N]
 #                         [--threads N] [--samplers sobol,cmj,...] [--ref-cache DIR]
 #                         [SCENE...]   (default scenes: Cornell box, DOF)
-# Not run in CI; see crates/candela-scene/examples/sampler_relmse.rs for the metric.
+# Not run in CI; see crates/candela-bench/src/bin/sampler_relmse.rs for the metric.
 set -e
 cd "$(dirname "$0")/.."
 case " $* " in
 *.toml*|*.xml*) ;;
 *) set -- "$@" scenes/cornell.toml scenes/dof.toml ;;
 esac
-exec cargo run --release -q -p candela-scene --example sampler_relmse -- "$@"
+exec cargo run --release -q -p candela-bench --bin sampler_relmse -- "$@"

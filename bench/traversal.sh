@@ -13,8 +13,8 @@ here="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"
 root="$(dirname "$here")"
 repeats="${1:-3}"
 "$here/.venv/bin/python" -c 'import embreex, numpy' 2>/dev/null || "$here/setup.sh"
-(cd "$root" && cargo build --release -p candela-cli --example traversal)
-example="$root/target/release/examples/traversal"
+(cd "$root" && cargo build --release -p candela-bench --bin traversal)
+example="$root/target/release/traversal"
 out="$root/bench/out/traversal"
 mkdir -p "$out"
 echo "== BVH build, 2 threads"

@@ -4,4 +4,4 @@
 # Usage: bench/many_lights/run.sh [SECONDS_PER_RENDER]   (default 3; not part of CI)
 set -euo pipefail
 cd "$(dirname "$0")/../.."
-cargo run --release -p candela-core --example many_lights -- "${1:-3}"
+cargo run --release -p candela-bench --bin many_lights -- "${1:-3}"

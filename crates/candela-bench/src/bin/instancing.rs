@@ -1,7 +1,7 @@
 //! Memory and build time of N instances of an M-triangle mesh, instanced or flattened.
 //!
 //! ```text
-//! cargo run --release -p candela-core --example instancing -- [N] [M] [flatten]
+//! cargo run --release -p candela-bench --bin instancing -- [N] [M] [flatten]
 //! ```
 //!
 //! Builds the scene (a grid of N placements of one bumpy sphere of about M triangles),

@@ -29,6 +29,7 @@ use std::path::PathBuf;
 use std::sync::atomic::AtomicBool;
 use std::time::Instant;
 
+use candela_bench::rel_mse;
 use candela_core::desc::SceneDesc;
 use candela_core::integrator::render_with;
 use candela_core::sampler::{
@@ -346,22 +347,6 @@ fn image(
     let t = Instant::now();
     let r = render_with(&scene, s, range, &AtomicBool::new(false), &|_| {});
     (r.film.resolve(), t.elapsed().as_secs_f64())
-}
-
-fn rel_mse(x: &[Vec3], reference: &[Vec3]) -> f64 {
-    let sum: f64 = x
-        .iter()
-        .zip(reference)
-        .map(|(a, r)| {
-            (0..3)
-                .map(|c| {
-                    let (a, r) = (a[c] as f64, r[c] as f64);
-                    (a - r).powi(2) / (r * r + 1e-2)
-                })
-                .sum::<f64>()
-        })
-        .sum();
-    sum / (3 * x.len()) as f64
 }
 
 /// Mean and standard error of the mean.

@@ -25,6 +25,7 @@ use std::io::Write;
 use std::path::Path;
 use std::time::Instant;
 
+use candela_bench::cpu_seconds;
 use candela_core::accel::{Accel, NodeLayout, Shape, Simd};
 use candela_core::geometry::{Ray, TriangleHit};
 use candela_core::math::{offset_ray_origin, Frame};
@@ -404,21 +405,4 @@ fn build_bench(n: usize) {
         times[2].0,
         times[0].1
     );
-}
-
-/// CPU time of this process, all threads (Linux /proc; 0 elsewhere): on a loaded
-/// machine wall time says little, CPU time shows the work.
-fn cpu_seconds() -> f64 {
-    let Ok(stat) = std::fs::read_to_string("/proc/self/stat") else {
-        return 0.0;
-    };
-    // Fields after the parenthesised command name; utime and stime are the 12th and 13th.
-    let rest = &stat[stat.rfind(')').map_or(0, |i| i + 2)..];
-    let f: Vec<f64> = rest
-        .split(' ')
-        .skip(11)
-        .take(2)
-        .filter_map(|x| x.parse().ok())
-        .collect();
-    f.iter().sum::<f64>() / 100.0
 }

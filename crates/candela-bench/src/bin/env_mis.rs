@@ -13,6 +13,7 @@
 use std::sync::atomic::AtomicBool;
 use std::time::Instant;
 
+use candela_bench::rel_mse;
 use candela_core::desc::*;
 use candela_core::light::envmap::equirect;
 use candela_core::light::{EnvironmentSampling, Light};
@@ -122,19 +123,6 @@ fn render(
     let t = Instant::now();
     let r = candela_core::integrator::render(&scene, 0..spp, &AtomicBool::new(false), &|_| {});
     (r.film.resolve(), t.elapsed().as_secs_f64())
-}
-
-fn rel_mse(img: &[Vec3], reference: &[Vec3]) -> f64 {
-    let sum: f64 = img
-        .iter()
-        .zip(reference)
-        .map(|(x, r)| {
-            let d = (*x - *r).as_dvec3();
-            let r = r.as_dvec3();
-            (d * d / (r * r + glam::DVec3::splat(1e-2))).element_sum() / 3.0
-        })
-        .sum();
-    sum / img.len() as f64
 }
 
 fn main() {

@@ -7,12 +7,13 @@
 //!    and power, and a long street lit by 10⁴+ emissive triangles, most far from most
 //!    points. 3. The RIS candidate count swept on both scenes at equal time.
 //!
-//! `cargo run --release -p candela-core --example many_lights -- [SECONDS]`
+//! `cargo run --release -p candela-bench --bin many_lights -- [SECONDS]`
 //! (seconds per equal-time render, default 3; the reference takes 8×).
 
 use std::sync::atomic::AtomicBool;
 use std::time::Instant;
 
+use candela_bench::cpu_seconds;
 use candela_core::desc::*;
 use candela_core::film::Film;
 use candela_core::integrator::render;
@@ -31,22 +32,6 @@ const KINDS: [(LightSamplerKind, &str); 6] = [
     (LightSamplerKind::Bvh, "bvh"),
     (LightSamplerKind::RisBvh, "ris-bvh"),
 ];
-
-/// CPU seconds (user + system) this process has used, from /proc (Linux); the machine
-/// the benchmark runs on may be shared, so wall time alone overstates the cost.
-fn cpu_seconds() -> f64 {
-    let stat = std::fs::read_to_string("/proc/self/stat").unwrap_or_default();
-    let after = stat.rsplit(')').next().unwrap_or("");
-    let f: Vec<f64> = after
-        .split_whitespace()
-        .filter_map(|x| x.parse().ok())
-        .collect();
-    // Fields 14 and 15 (utime, stime) in clock ticks, usually 100 per second; after the
-    // ")" the first field is the state letter, which does not parse.
-    f.get(10)
-        .zip(f.get(11))
-        .map_or(f64::NAN, |(u, s)| (u + s) / 100.0)
-}
 
 fn build_cost() {
     let n = 1_000_000;

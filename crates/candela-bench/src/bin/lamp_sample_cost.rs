@@ -4,7 +4,7 @@
 //! `LampSampling::SolidAngle`), 4·10⁶ calls each on one thread.
 //!
 //! ```text
-//! cargo run --release -p candela-core --example lamp_sample_cost
+//! cargo run --release -p candela-bench --bin lamp_sample_cost
 //! ```
 //!
 //! Not part of CI; bench/RESULTS.md quotes it (lamp_sample_cost). Wall time per call, so
