@@ -20,6 +20,7 @@ use crate::sampler::{IndependentSampler, Sampler, SobolCmjSampler, SobolSampler}
 use crate::sampling::{balance_heuristic, power_heuristic};
 use crate::scene::{Scene, SurfaceInteraction};
 
+mod sky;
 mod volpath;
 
 /// Rows per parallel work item.
@@ -364,16 +365,8 @@ fn li_isa<S: Sampler, const V3: bool>(
             break;
         }
         let Some(si) = hit.as_ref() else {
-            for &id in &scene.infinite_lights {
-                let light = scene.light(id);
-                let le = if depth == 0 {
-                    light.le_camera(&ray)
-                } else {
-                    light.le(&ray)
-                };
-                if le != Vec3::ZERO {
-                    l += beta * le * emitter_weight(specular, &prev_ctx, prev_bsdf_pdf, id, ray.d);
-                }
+            for (id, le) in sky::escaped(scene, &ray, depth == 0) {
+                l += beta * le * emitter_weight(specular, &prev_ctx, prev_bsdf_pdf, id, ray.d);
             }
             break;
         };
