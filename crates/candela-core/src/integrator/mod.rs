@@ -26,6 +26,7 @@ mod copies;
 mod direct;
 mod path;
 mod schedule;
+mod sky;
 mod volpath;
 
 pub(crate) use band::{camera_ray, Band, SampleSink};

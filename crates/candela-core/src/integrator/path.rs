@@ -82,16 +82,8 @@ pub(super) fn li_isa<S: Sampler, const V3: bool>(
             break;
         }
         let Some(si) = hit.as_ref() else {
-            for &id in &scene.infinite_lights {
-                let light = scene.light(id);
-                let le = if depth == 0 {
-                    light.le_camera(&ray)
-                } else {
-                    light.le(&ray)
-                };
-                if le != Vec3::ZERO {
-                    l += beta * le * emitter_weight(specular, &prev_ctx, prev_bsdf_pdf, id, ray.d);
-                }
+            for (id, le) in super::sky::escaped(scene, &ray, depth == 0) {
+                l += beta * le * emitter_weight(specular, &prev_ctx, prev_bsdf_pdf, id, ray.d);
             }
             break;
         };

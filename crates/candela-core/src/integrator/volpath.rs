@@ -1,8 +1,8 @@
 //! The volumetric path tracer, chosen for scenes with participating media or null
 //! surfaces (pbrt-v4's `VolPathIntegrator`, over RGB): delta tracking of the camera path
 //! against each medium's majorant, next event estimation from surfaces and from medium
-//! collisions with transmittance through media and null boundaries, and MIS by the balance
-//! heuristic between light sampling and BSDF/phase sampling.
+//! collisions with transmittance through media and null boundaries, and MIS between light
+//! sampling and BSDF/phase sampling as the scene's [`MisMode`] says.
 //!
 //! The path keeps three vectors, as pbrt-v4 does: `beta`, the throughput divided by the
 //! hero channel's path density; `r_u`, each channel's density of the path so far relative
@@ -12,10 +12,21 @@
 //! strategy then samples no distance, and the camera path's `r_l` through it is divided by
 //! the hero's pass-through probability instead of multiplied by the channel's.
 //! Heterogeneous media are crossed by ratio tracking with Russian roulette.
+//!
+//! With a hero channel drawn uniformly, a strategy's density of a path is the mean over
+//! the channels of its per-channel densities (the balance heuristic over channels, which
+//! keeps every channel unbiased); `r_u` and `r_l`, relative to the density the path was
+//! drawn with, give it as `mean(r)`. The two strategies are then combined by the
+//! [`MisMode`]'s heuristic on those means, as the path tracer combines its two
+//! (`weighted`): balance, power, light sampling only (`none`: emitters found by phase or
+//! BSDF sampling count only after a delta bounce) or BSDF/phase sampling only (`bsdf`:
+//! shadow rays only towards delta lights).
 
 use glam::Vec3;
 
+use super::sky;
 use crate::bsdf::Bsdf;
+use crate::desc::MisMode;
 use crate::geometry::Ray;
 use crate::light::{LightSample, ShadingCtx};
 use crate::math::{max_component, offset_ray_origin};
@@ -31,6 +42,21 @@ const MAX_CROSSINGS: u32 = 256;
 #[inline]
 fn mean(v: Vec3) -> f32 {
     (v.x + v.y + v.z) * (1.0 / 3.0)
+}
+
+/// The factor that turns a sample of one strategy into its MIS-weighted contribution: its
+/// weight against the other strategy over its own density, each density given by its
+/// ratios to the sampled one (`own` and `other`, see the module's notes) through their
+/// mean over the channels. Light-only and BSDF-only modes give the strategy in use its
+/// whole weight (callers drop the other).
+#[inline]
+fn weighted(mode: MisMode, own: Vec3, other: Vec3) -> f32 {
+    let (p, q) = (mean(own), mean(other));
+    match mode {
+        MisMode::Balance => 1.0 / (p + q),
+        MisMode::Power => p / (p * p + q * q),
+        MisMode::NeeOnly | MisMode::BsdfOnly => 1.0 / p,
+    }
 }
 
 /// Whether a throughput or density ratio can still carry light.
@@ -58,14 +84,22 @@ struct Path {
 
 impl Path {
     /// Radiance `le` found along the path: in full after a delta bounce, else weighted
-    /// against light sampling, whose density of the found point is `p_light`.
+    /// by `mode` against light sampling, whose density of the found point is `p_light`.
     #[inline]
-    fn emitted(&self, le: Vec3, specular: bool, p_light: impl FnOnce() -> f32) -> Vec3 {
-        if specular {
-            self.beta * le / mean(self.r_u)
-        } else {
-            self.beta * le / mean(self.r_u + self.r_l * p_light())
-        }
+    fn emitted(
+        &self,
+        mode: MisMode,
+        le: Vec3,
+        specular: bool,
+        p_light: impl FnOnce() -> f32,
+    ) -> Vec3 {
+        let w = match mode {
+            _ if specular => 1.0 / mean(self.r_u),
+            MisMode::NeeOnly => return Vec3::ZERO,
+            MisMode::BsdfOnly => 1.0 / mean(self.r_u),
+            _ => weighted(mode, self.r_u, self.r_l * p_light()),
+        };
+        self.beta * le * w
     }
 }
 
@@ -78,6 +112,7 @@ pub(crate) fn li<S: Sampler>(
     rays: &mut u64,
 ) -> Vec3 {
     let settings = &scene.settings;
+    let mode = settings.mis;
     let hero = ((sampler.get_1d() * 3.0) as usize).min(2);
     let mut path = Path {
         beta: Vec3::ONE,
@@ -176,16 +211,11 @@ pub(crate) fn li<S: Sampler>(
         }
 
         let Some(si) = hit else {
-            for &id in &scene.infinite_lights {
-                let light = scene.light(id);
-                let le = if depth == 0 {
-                    light.le_camera(&ray)
-                } else {
-                    light.le(&ray)
-                };
-                if le != Vec3::ZERO && !hidden(depth) {
-                    l += path.emitted(le, specular, || {
-                        scene.light_sampler.pmf(&prev_ctx, id) * light.pdf_li(&prev_ctx, ray.d)
+            if !hidden(depth) {
+                for (id, le) in sky::escaped(scene, &ray, depth == 0) {
+                    l += path.emitted(mode, le, specular, || {
+                        let pdf = scene.light(id).pdf_li(&prev_ctx, ray.d);
+                        scene.light_sampler.pmf(&prev_ctx, id) * pdf
                     });
                 }
             }
@@ -196,7 +226,7 @@ pub(crate) fn li<S: Sampler>(
             let light = scene.light(id);
             let le = light.radiance(si.ng, si.uv, wo);
             if le != Vec3::ZERO && !hidden(depth) {
-                l += path.emitted(le, specular, || {
+                l += path.emitted(mode, le, specular, || {
                     scene.light_sampler.pmf(&prev_ctx, id) * light.pdf_li(&prev_ctx, ray.d)
                 });
             }
@@ -287,8 +317,8 @@ enum Vertex<'a> {
 }
 
 /// Next event estimation at a vertex: one light picked by the light sampler, one point on
-/// it, its transmittance through media and null surfaces, and the balance heuristic
-/// against BSDF or phase sampling, over the channels.
+/// it, its transmittance through media and null surfaces, and the scene's MIS weight
+/// against BSDF or phase sampling (see the module's notes).
 #[allow(clippy::too_many_arguments)]
 fn sample_ld<S: Sampler>(
     scene: &Scene,
@@ -302,10 +332,16 @@ fn sample_ld<S: Sampler>(
 ) -> Vec3 {
     let u_light = sampler.get_1d();
     let u_point = sampler.get_2d();
+    let mode = scene.settings.mis;
     let Some(pick) = scene.light_sampler.sample(ctx, u_light, &scene.lights) else {
         return Vec3::ZERO;
     };
-    let Some(ls) = scene.light(pick.id).sample_li(ctx, u_point) else {
+    let light = scene.light(pick.id);
+    // BSDF-only estimation still needs NEE for delta lights, which no ray can hit.
+    if mode == MisMode::BsdfOnly && !light.is_delta() {
+        return Vec3::ZERO;
+    }
+    let Some(ls) = light.sample_li(ctx, u_point) else {
         return Vec3::ZERO;
     };
     let (f, scatter_pdf, origin, medium) = match *v {
@@ -344,7 +380,7 @@ fn sample_ld<S: Sampler>(
     // weight also uses (see `integrator::light_contribution`).
     let r_l = r_p * tr.r_l * (pick.mis_pmf * ls.pdf);
     let r_u = r_p * tr.r_u * scatter_pdf;
-    beta * f * tr.t * ls.radiance * (pick.mis_pmf / pick.pmf) / mean(r_l + r_u)
+    beta * f * tr.t * ls.radiance * (pick.mis_pmf / pick.pmf) * weighted(mode, r_l, r_u)
 }
 
 /// A shadow ray's transmittance estimate and the density ratios of its two strategies.

@@ -1,10 +1,12 @@
 //! A heterogeneous medium on a voxel grid: σt = scale × a trilinearly interpolated grid,
 //! σs = albedo × σt with the albedo constant or on a grid of its own, inside the unit cube
-//! of the grid's local space (placed in the world by a transform), empty outside.
+//! of the grid's local space (placed in the world by a transform), empty outside. Its
+//! majorants are those of a coarse grid over the cube ([`MajorantGrid`]).
 
 use glam::{Affine3A, Vec3};
 
-use super::{HenyeyGreenstein, MajorantSegment, MediumProperties};
+use super::majorant::{MajorantGrid, MAJORANT_CELLS};
+use super::{HenyeyGreenstein, Majorants, MediumProperties};
 use crate::geometry::Ray;
 
 /// Values on a 3D grid of `res` cells (x fastest, then y, then z), one or three channels
@@ -45,8 +47,9 @@ impl VoxelGrid {
         })
     }
 
+    /// The value of voxel (x, y, z), in range.
     #[inline]
-    fn cell(&self, x: u32, y: u32, z: u32) -> Vec3 {
+    pub fn cell(&self, x: u32, y: u32, z: u32) -> Vec3 {
         let [nx, ny, _] = self.res;
         let i = ((z * ny + y) * nx + x) as usize;
         if self.channels == 1 {
@@ -107,11 +110,12 @@ pub struct GridMedium {
     pub scale: f32,
     pub world_to_local: Affine3A,
     pub phase: HenyeyGreenstein,
-    /// scale × the grid's maximum: the majorant over the whole cube.
-    sigma_maj: Vec3,
+    /// Bounds of σt over the cells of a coarse grid.
+    majorants: MajorantGrid,
 }
 
 impl GridMedium {
+    /// The medium, with majorants on a grid of up to [`MAJORANT_CELLS`]³ cells.
     pub fn new(
         sigma_t: VoxelGrid,
         albedo: Albedo,
@@ -119,15 +123,23 @@ impl GridMedium {
         world_to_local: Affine3A,
         phase: HenyeyGreenstein,
     ) -> GridMedium {
-        let sigma_maj = sigma_t.max() * scale;
+        let majorants = MajorantGrid::new(&sigma_t, scale, [MAJORANT_CELLS; 3]);
         GridMedium {
             sigma_t,
             albedo,
             scale,
             world_to_local,
             phase,
-            sigma_maj,
+            majorants,
         }
+    }
+
+    /// The same medium with majorants on `cells` cells per axis (each at most the grid's
+    /// resolution): `[1, 1, 1]` gives the grid's maximum everywhere, which tests compare
+    /// the coarse grid against.
+    pub fn with_majorant_cells(mut self, cells: [u32; 3]) -> GridMedium {
+        self.majorants = MajorantGrid::new(&self.sigma_t, self.scale, cells);
+        self
     }
 
     /// The coefficients at world point `p` (zero outside the cube).
@@ -153,10 +165,10 @@ impl GridMedium {
         }
     }
 
-    /// The stretch of the ray inside the cube, clipped to (0, t_max), with the grid's
-    /// majorant.
+    /// The stretch of the ray inside the cube, clipped to (0, t_max), cell by cell of the
+    /// majorant grid.
     #[inline]
-    pub fn majorant(&self, ray: &Ray, t_max: f32) -> Option<MajorantSegment> {
+    pub fn majorants(&self, ray: &Ray, t_max: f32) -> Majorants<'_> {
         // An affine map keeps the ray's parameter: t in local space is t in the world.
         let o = self.world_to_local.transform_point3(ray.o);
         let d = self.world_to_local.transform_vector3(ray.d);
@@ -168,11 +180,11 @@ impl GridMedium {
         // other axes through max/min.
         let t0 = lo.max_element().max(0.0);
         let t1 = hi.min_element().min(t_max);
-        (t0 < t1).then_some(MajorantSegment {
-            t0,
-            t1,
-            sigma_maj: self.sigma_maj,
-        })
+        if t0 < t1 {
+            Majorants::Walk(self.majorants.walk(o, d, t0, t1))
+        } else {
+            Majorants::One(None)
+        }
     }
 }
 
@@ -213,12 +225,14 @@ mod tests {
             HenyeyGreenstein::ISOTROPIC,
         );
         let ray = Ray::new(Vec3::new(-5.0, 0.0, 0.0), Vec3::X);
-        let s = m.majorant(&ray, 100.0).unwrap();
-        assert!((s.t0 - 4.0).abs() < 1e-5 && (s.t1 - 6.0).abs() < 1e-5);
-        assert_eq!(s.sigma_maj, Vec3::splat(6.0));
-        assert!(m.majorant(&ray, 3.0).is_none());
+        let s: Vec<_> = m.majorants(&ray, 100.0).collect();
+        assert_eq!(s.len(), 1);
+        assert!((s[0].t0 - 4.0).abs() < 1e-5 && (s[0].t1 - 6.0).abs() < 1e-5);
+        assert_eq!(s[0].sigma_maj, Vec3::splat(6.0));
+        assert!(m.majorants(&ray, 3.0).next().is_none());
         assert!(m
-            .majorant(&Ray::new(Vec3::new(-5.0, 2.0, 0.0), Vec3::X), 100.0)
+            .majorants(&Ray::new(Vec3::new(-5.0, 2.0, 0.0), Vec3::X), 100.0)
+            .next()
             .is_none());
         assert_eq!(
             m.properties(Vec3::new(0.5, 0.5, 0.5)).sigma_s,

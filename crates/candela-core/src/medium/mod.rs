@@ -6,8 +6,8 @@
 //!
 //! - [`homogeneous`]: constant coefficients, majorant = σt, so no null collisions; its
 //!   transmittance has a closed form.
-//! - [`grid`]: a trilinearly interpolated 3D grid of σt (times a scale) and an albedo, with
-//!   the grid's maximum as the majorant.
+//! - [`grid`]: a trilinearly interpolated 3D grid of σt (times a scale) and an albedo,
+//!   with a majorant per cell of a coarse grid ([`majorant`]).
 //! - [`phase`]: isotropic and Henyey–Greenstein phase functions.
 //! - [`tracking`]: the collision sampler shared by the camera path and shadow rays.
 //!
@@ -19,6 +19,7 @@
 
 pub mod grid;
 pub mod homogeneous;
+pub mod majorant;
 pub mod phase;
 pub mod tracking;
 
@@ -26,6 +27,7 @@ use glam::Vec3;
 
 pub use grid::{GridMedium, VoxelGrid};
 pub use homogeneous::Homogeneous;
+pub use majorant::{MajorantGrid, MajorantWalk};
 pub use phase::HenyeyGreenstein;
 
 use crate::geometry::Ray;
@@ -50,6 +52,27 @@ pub struct MajorantSegment {
     pub sigma_maj: Vec3,
 }
 
+/// The stretches of constant majorant along a ray, in order and end to end.
+#[derive(Clone, Debug)]
+pub enum Majorants<'a> {
+    /// At most one stretch (a homogeneous medium, or a grid's single majorant).
+    One(Option<MajorantSegment>),
+    /// A grid's cells along the ray.
+    Walk(MajorantWalk<'a>),
+}
+
+impl Iterator for Majorants<'_> {
+    type Item = MajorantSegment;
+
+    #[inline]
+    fn next(&mut self) -> Option<MajorantSegment> {
+        match self {
+            Majorants::One(s) => s.take(),
+            Majorants::Walk(w) => w.next(),
+        }
+    }
+}
+
 /// A participating medium.
 #[derive(Clone, Debug)]
 pub enum Medium {
@@ -67,17 +90,17 @@ impl Medium {
         }
     }
 
-    /// The stretch of `ray` within `(0, t_max)` where the medium may be non-empty, and its
-    /// majorant; `None` where the ray misses it.
+    /// The stretches of `ray` within `(0, t_max)` where the medium may be non-empty, in
+    /// order, each with a majorant; none where the ray misses it.
     #[inline]
-    pub fn majorant(&self, ray: &Ray, t_max: f32) -> Option<MajorantSegment> {
+    pub fn majorants(&self, ray: &Ray, t_max: f32) -> Majorants<'_> {
         match self {
-            Medium::Homogeneous(m) => Some(MajorantSegment {
+            Medium::Homogeneous(m) => Majorants::One(Some(MajorantSegment {
                 t0: 0.0,
                 t1: t_max,
                 sigma_maj: m.sigma_t(),
-            }),
-            Medium::Grid(m) => m.majorant(ray, t_max),
+            })),
+            Medium::Grid(m) => m.majorants(ray, t_max),
         }
     }
 
