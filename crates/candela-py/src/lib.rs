@@ -1,7 +1,9 @@
 //! `candela._candela`: the native half of the Python package. The Python half
 //! (`python/candela/__init__.py`) turns pixels into NumPy arrays and draws the progress
-//! bar; this half loads scenes, renders with the GIL released, writes images and reads,
-//! writes and merges film parts.
+//! bar; this half loads scenes, renders with the GIL released, writes images, reads,
+//! writes and merges film parts, and denoises images ([`denoise`]).
+
+mod denoise;
 
 use std::ops::Range;
 use std::path::PathBuf;
@@ -80,6 +82,28 @@ impl Scene {
             self.path, r.width, r.height, r.spp
         )
     }
+}
+
+impl Scene {
+    /// The description with the render's own spp and seed overrides.
+    fn with_overrides(&self, spp: Option<u32>, seed: Option<u64>) -> SceneDesc {
+        let mut desc = self.desc.clone();
+        if let Some(spp) = spp {
+            desc.render.spp = spp;
+        }
+        if let Some(seed) = seed {
+            desc.render.seed = seed;
+        }
+        desc
+    }
+}
+
+/// A pool of `threads` workers (default: one a core).
+fn thread_pool(threads: Option<usize>) -> PyResult<rayon::ThreadPool> {
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(threads.unwrap_or(0))
+        .build()
+        .map_err(|e| PyValueError::new_err(format!("cannot start threads: {e}")))
 }
 
 /// The film of a range of sample indices: exact per-pixel sums that merge bit for bit.
@@ -228,13 +252,7 @@ fn render_film(
     threads: Option<usize>,
     progress: Option<PyObject>,
 ) -> PyResult<Film> {
-    let mut desc = scene.desc.clone();
-    if let Some(spp) = spp {
-        desc.render.spp = spp;
-    }
-    if let Some(seed) = seed {
-        desc.render.seed = seed;
-    }
+    let desc = scene.with_overrides(spp, seed);
     let total_spp = desc.render.spp;
     let range: Range<u32> = match samples {
         None => 0..total_spp,
@@ -248,10 +266,7 @@ fn render_film(
     let built = py
         .allow_threads(|| candela_core::build::build(&desc))
         .map_err(|e| SceneError::new_err(e.to_string()))?;
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(threads.unwrap_or(0))
-        .build()
-        .map_err(|e| PyValueError::new_err(format!("cannot start threads: {e}")))?;
+    let pool = thread_pool(threads)?;
     let (w, h) = (built.settings.width as u64, built.settings.height as u64);
     let total = w * h * range.len() as u64;
     let cancel = AtomicBool::new(false);
@@ -425,6 +440,7 @@ fn _candela(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<Film>()?;
     m.add("SceneError", m.py().get_type::<SceneError>())?;
     m.add("MergeError", m.py().get_type::<MergeError>())?;
+    m.add("DenoiseError", m.py().get_type::<denoise::DenoiseError>())?;
     m.add_function(wrap_pyfunction!(load, m)?)?;
     m.add_function(wrap_pyfunction!(render_film, m)?)?;
     m.add_function(wrap_pyfunction!(merge, m)?)?;
@@ -432,5 +448,7 @@ fn _candela(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(_film_from_bytes, m)?)?;
     m.add_function(wrap_pyfunction!(write_pixels, m)?)?;
     m.add_function(wrap_pyfunction!(info, m)?)?;
+    m.add_function(wrap_pyfunction!(denoise::denoise, m)?)?;
+    m.add_function(wrap_pyfunction!(denoise::render_aovs, m)?)?;
     Ok(())
 }
