@@ -14,7 +14,7 @@ use candela_cli::merge::{merge_parts, NamedPart};
 use candela_cli::output::{write_image, LinearImage};
 use candela_cli::part::{read_part, write_part, PartInfo};
 use candela_cli::tonemap::{DisplayTransform, Tonemap};
-use candela_core::desc::SceneDesc;
+use candela_core::desc::{FilterSampling, SceneDesc};
 use candela_core::film::Film as CoreFilm;
 use candela_core::integrator;
 use clap::ValueEnum;
@@ -241,8 +241,11 @@ fn load(
 
 /// Renders `samples` (default 0..spp) of the scene with optional spp and seed overrides.
 /// `progress(done, total)` is called from the waiting thread (with the GIL) every 50 ms.
+/// `filter_sampling`: "splat" or "importance" over the scene's own.
 #[pyfunction]
-#[pyo3(signature = (scene, spp=None, seed=None, samples=None, threads=None, progress=None))]
+#[pyo3(signature = (scene, spp=None, seed=None, samples=None, threads=None, progress=None,
+                    filter_sampling=None))]
+#[allow(clippy::too_many_arguments)]
 fn render_film(
     py: Python<'_>,
     scene: &Scene,
@@ -251,8 +254,19 @@ fn render_film(
     samples: Option<(u32, u32)>,
     threads: Option<usize>,
     progress: Option<PyObject>,
+    filter_sampling: Option<&str>,
 ) -> PyResult<Film> {
-    let desc = scene.with_overrides(spp, seed);
+    let mut desc = scene.with_overrides(spp, seed);
+    match filter_sampling {
+        None => {}
+        Some("splat") => desc.render.filter_sampling = FilterSampling::Splat,
+        Some("importance") => desc.render.filter_sampling = FilterSampling::Importance,
+        Some(other) => {
+            return Err(PyValueError::new_err(format!(
+                "filter_sampling must be \"splat\" or \"importance\", got {other:?}"
+            )))
+        }
+    }
     let total_spp = desc.render.spp;
     let range: Range<u32> = match samples {
         None => 0..total_spp,

@@ -44,9 +44,12 @@ def cornell(tmp_path: Path, res: int) -> candela.Scene:
     return candela.load(p)
 
 
-def relmse(x: np.ndarray, ref: np.ndarray) -> float:
-    """Per pixel and channel (x − ref)²/(ref² + 10⁻²), averaged."""
-    return float(((x.astype(np.float64) - ref) ** 2 / (ref.astype(np.float64) ** 2 + 1e-2)).mean())
+def relmse(x: np.ndarray, ref: np.ndarray, drop: float = 0.0) -> float:
+    """Per pixel (x − ref)²/(ref² + 10⁻²), mean over channels, averaged over the pixels
+    but the worst ``drop`` fraction."""
+    x, ref = x.astype(np.float64), ref.astype(np.float64)
+    e = np.sort(((x - ref) ** 2 / (ref ** 2 + 1e-2)).mean(axis=-1).ravel())
+    return float(e[: int(round(len(e) * (1.0 - drop)))].mean())
 
 
 def test_wrong_arrays_raise_clear_errors():
@@ -164,3 +167,40 @@ def test_the_gil_is_released_while_filtering(oidn):
     during = [x for x in ticks if start <= x <= start + elapsed]
     # A thread starved of the GIL would tick about once per call; it ticks throughout.
     assert elapsed > 0.2 and len(during) >= 0.2 * elapsed / 0.01, (elapsed, len(during))
+
+
+def test_a_wide_filter_must_be_importance_sampled_to_denoise(oidn, tmp_path, candela_bin):
+    """Mitsuba's Cornell box with Mitsuba's default Gaussian filter at 96², 16 spp,
+    denoised with two seeds: the noise OIDN leaves is what differs between the two
+    results. Splatted, the noise is correlated between neighbouring pixels and OIDN
+    leaves most of it (its documentation: not supported); importance-sampled, it goes.
+    Measured: relMSE between the two denoised images, worst 1 % of pixels dropped (the
+    lamp's edge, which the filter places differently each time), 0.0069 splatted against
+    0.00094 importance-sampled (7.4×); the test asks for 3×. ``filter_sampling=
+    "importance"`` is the CLI's ``--filter-sampling importance``, bit for bit."""
+    xml = (REPO / "scenes/mitsuba-cornell.xml").read_text()
+    assert '<rfilter type="box"/>' in xml
+    p = tmp_path / "gaussian.xml"
+    p.write_text(xml.replace('<rfilter type="box"/>', ""))
+    scene = candela.load(p, res=96)
+    with pytest.raises(ValueError, match="filter_sampling must be"):
+        candela.render(scene, spp=1, filter_sampling="gaussian")
+    left = {}
+    for how in ("splat", "importance"):
+        denoised = []
+        for seed in (2, 3):
+            passes = candela.render_aovs(scene, spp=16, seed=seed)
+            img = candela.render(scene, spp=16, seed=seed, filter_sampling=how)
+            denoised.append(candela.denoise(img, passes["albedo"], passes["normal"]))
+        left[how] = relmse(*denoised, drop=0.01)
+    print(f"noise left: splatted {left['splat']:.5f}, importance-sampled {left['importance']:.5f}")
+    assert left["importance"] < left["splat"] / 3, left
+    out = tmp_path / "cli.pfm"
+    subprocess.run(
+        [candela_bin, "render", p, "-D", "res=96", "--spp", "16", "--seed", "2",
+         "--filter-sampling", "importance", "-o", out],
+        check=True, capture_output=True,
+    )
+    data = out.read_bytes().split(b"\n", 3)[3]
+    cli = np.frombuffer(data, dtype="<f4").reshape(96, 96, 3)[::-1]
+    assert np.array_equal(cli, candela.render(scene, spp=16, seed=2, filter_sampling="importance"))

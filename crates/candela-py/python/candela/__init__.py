@@ -9,8 +9,9 @@ Sample ranges merge exactly: ``candela.merge([candela.render(scene, samples=rang
 candela.render(scene, samples=range(8, 16))]).image()`` equals ``candela.render(scene)``
 bit for bit. ``python -m candela.distributed`` runs such ranges as Ray tasks.
 
-``candela.denoise(img, **candela.render_aovs(scene, spp=16))`` runs Intel Open Image
-Denoise (``pip install pyoidn``) on an image, guided by its albedo and normal passes.
+``candela.denoise(img, p["albedo"], p["normal"])``, with ``p = candela.render_aovs(scene,
+spp=16)``, runs Intel Open Image Denoise (``pip install pyoidn``) on an image, guided by
+its albedo and normal passes.
 """
 
 from __future__ import annotations
@@ -113,12 +114,16 @@ def render(
     threads: Optional[int] = None,
     progress: bool = False,
     samples: Optional[range] = None,
+    filter_sampling: Optional[str] = None,
 ) -> Union[np.ndarray, Film]:
     """Renders a scene.
 
     ``spp`` and ``seed`` override the scene's own; the same seed gives the same image,
     bit for bit the CLI's ``candela render --spp N --seed S``. ``threads``: worker
     threads (default: all cores). ``progress=True`` draws a bar on stderr.
+    ``filter_sampling``: ``"splat"`` or ``"importance"`` over the scene's own (as
+    ``--filter-sampling``), for a pixel filter wider than a pixel (a Mitsuba scene's
+    tent or Gaussian); an image for :func:`denoise` needs ``"importance"``.
 
     Without ``samples`` it returns the image, a float32 array (height, width, 3) of
     linear radiance. With ``samples=range(a, b)`` (within ``range(spp)``, step 1) it
@@ -134,7 +139,7 @@ def render(
             raise ValueError("samples must be a range(a, b) with step 1")
         bounds = (samples.start, samples.stop)
     bar = _Bar() if progress else None
-    film = _candela.render_film(scene, spp, seed, bounds, threads, bar)
+    film = _candela.render_film(scene, spp, seed, bounds, threads, bar, filter_sampling)
     return film if samples is not None else film_image(film)
 
 
@@ -152,9 +157,11 @@ def render_aovs(
     Returns ``{"albedo": (H, W, 3), "normal": (H, W, 3), "depth": (H, W)}``, float32:
     albedo in [0, 1], world-space shading normals (averaged, not renormalized; zero
     where nothing is hit), depth along the camera's axis (+inf where nothing is hit).
-    ``candela.denoise(img, **{k: v for k, v in passes.items() if k != "depth"})``, or
-    simply ``candela.denoise(img, passes["albedo"], passes["normal"])``, denoises with
-    them. The GIL is released while rendering.
+    ``candela.denoise(img, passes["albedo"], passes["normal"])`` denoises ``img =
+    candela.render(scene, spp=..., seed=...)`` with them. Each pass's camera rays are
+    filter-importance-sampled: they match ``render(..., filter_sampling="importance")``
+    (any filter; the box filter renders the same either way). The GIL is released while
+    rendering.
     """
     raw = _candela.render_aovs(scene, spp, seed, threads)
     w, h = scene.resolution
@@ -264,6 +271,11 @@ def denoise(
     are denoised first and the image's filter is told they are clean, OIDN's
     high-quality recipe for guides rendered with the image's noise; ``prefilter=False``
     passes them as they are. ``threads``: OIDN's threads (default: all cores).
+
+    OIDN cannot denoise a splatted image: render a scene whose pixel filter is wider
+    than a pixel (a Mitsuba scene's tent or Gaussian, Mitsuba's default) with
+    ``candela.render(..., filter_sampling="importance")``, as ``candela render
+    --denoise`` does; TOML scenes use the box filter, which needs nothing.
 
     Returns a new float32 array (height, width, 3). The GIL is released while filtering.
     Raises ``TypeError`` / ``ValueError`` for arrays of another dtype, shape or with
