@@ -8,7 +8,10 @@ channels, ε = 1e-2; a denoiser rightly softens the edges of directly seen lamps
 plain relMSE punishes out of all proportion; plain relMSE is printed too) and HDR-FLIP
 (`flip-evaluator` from PyPI, its default exposure range and 67 pixels per degree).
 Times are candela's own: the path tracer, plus the AOV pass and the denoiser where they
-ran (loading, building and writing excluded), on all the machine's cores.
+ran (loading, building and writing excluded), on all the machine's cores (or --threads).
+Scenes render at their own resolution (--scale for a fraction of it); references are
+kept in --out and reused, so `--scenes cornell` then `--scenes glass_sphere` run one
+reference at a time.
 
 Run through bench/denoise.sh, which makes target/oidn-venv with pyoidn, numpy and
 flip-evaluator and points OIDN_DIR at the wheel's library.
@@ -28,12 +31,11 @@ from benchlib import machine, report  # noqa: E402
 from benchlib.images import RELMSE_EPS, read_pfm  # noqa: E402
 
 REPO = os.path.dirname(here)
-# (scene, reduced resolution): a quarter to a half of each scene's own, so that the three
-# 4096-spp references take minutes on a shared 2-core machine.
+# The Cornell box and two other bundled scenes, at their own resolutions unless --scale.
 SCENES = [
-    ("scenes/cornell.toml", (128, 128)),
-    ("scenes/glass_sphere.toml", (160, 120)),
-    ("scenes/plastics.toml", (240, 80)),
+    ("scenes/cornell.toml", (512, 512)),
+    ("scenes/glass_sphere.toml", (320, 240)),
+    ("scenes/plastics.toml", (480, 160)),
 ]
 SUMMARY = re.compile(r"(\d+)x(\d+), (\d+) spp, ([\d.]+) s,")
 PASSES = re.compile(r"passes [a-z, ]+ in ([\d.]+) s")
@@ -41,10 +43,12 @@ DENOISED = re.compile(r"denoised \([^)]*\) in ([\d.]+) s")
 DROP = 0.01
 
 
-def render(binary, scene, out, res, spp, seed, extra=()):
+def render(binary, scene, out, res, spp, seed, threads, extra=()):
     """Renders and returns candela's time: path tracer + AOV pass + denoiser."""
     cmd = [binary, "render", scene, "-o", out, "--spp", str(spp), "--seed", str(seed),
            "--res", f"{res[0]}x{res[1]}", *extra]
+    if threads:
+        cmd += ["--threads", str(threads)]
     p = subprocess.run(cmd, cwd=REPO, capture_output=True, text=True)
     if p.returncode != 0:
         raise RuntimeError(f"{' '.join(cmd)} failed ({p.returncode}):\n{p.stderr}{p.stdout}")
@@ -66,11 +70,17 @@ def relmse_dropped(x, ref):
 
 
 def flip_hdr(x, ref):
+    """HDR-FLIP's mean error and the exposure range it chose from the reference."""
     import flip_evaluator as flip
-    _, mean, _ = flip.evaluate(np.ascontiguousarray(ref, dtype=np.float32),
-                               np.ascontiguousarray(np.maximum(x, 0.0), dtype=np.float32),
-                               "HDR", applyMagma=False)
-    return float(mean)
+    _, mean, params = flip.evaluate(np.ascontiguousarray(ref, dtype=np.float32),
+                                    np.ascontiguousarray(np.maximum(x, 0.0), dtype=np.float32),
+                                    "HDR", applyMagma=False)
+    return float(mean), params
+
+
+def name_of(scene):
+    """scenes/cornell.toml -> cornell."""
+    return os.path.splitext(os.path.basename(scene))[0]
 
 
 def main():
@@ -78,6 +88,12 @@ def main():
     ap.add_argument("--binary", default=os.path.join(REPO, "target/release/candela"))
     ap.add_argument("--ref-spp", type=int, default=4096)
     ap.add_argument("--out", default=os.path.join(here, "out/denoise"))
+    ap.add_argument("--scale", type=float, default=1.0,
+                    help="resolution as a fraction of each scene's own (default 1)")
+    ap.add_argument("--threads", type=int, default=0,
+                    help="candela's threads (default: all cores)")
+    ap.add_argument("--scenes", default="cornell,glass_sphere,plastics",
+                    help="comma-separated names of the scenes to run, in order")
     a = ap.parse_args()
     os.makedirs(a.out, exist_ok=True)
     info = machine.describe(REPO)
@@ -91,23 +107,30 @@ def main():
         ("denoised, albedo + normal", 64, ("--denoise",)),
     ]
     rows = []
-    for scene, res in SCENES:
-        name = os.path.splitext(os.path.basename(scene))[0]
-        ref_path = os.path.join(a.out, f"{name}-ref{a.ref_spp}.pfm")
+    scenes = {name_of(scene): (scene, own) for scene, own in SCENES}
+    for name in a.scenes.split(","):
+        scene, own = scenes[name]
+        res = (round(own[0] * a.scale), round(own[1] * a.scale))
+        tag = f"{name}-{res[0]}x{res[1]}"
+        ref_path = os.path.join(a.out, f"{tag}-ref{a.ref_spp}.pfm")
         if not os.path.exists(ref_path):
-            t = render(a.binary, scene, ref_path, res, a.ref_spp, seed=1)
+            t = render(a.binary, scene, ref_path, res, a.ref_spp, 1, a.threads)
             print(f"{name}: reference {a.ref_spp} spp in {t:.1f} s", flush=True)
         ref = read_pfm(ref_path)
         for label, spp, extra in variants:
-            out = os.path.join(a.out, f"{name}-{spp}-{'-'.join(extra) or 'raw'}.pfm")
-            t = render(a.binary, scene, out, res, spp, seed=2, extra=extra)
+            out = os.path.join(a.out, f"{tag}-{spp}-{'-'.join(extra) or 'raw'}.pfm")
+            t = render(a.binary, scene, out, res, spp, 2, a.threads, extra)
             x = read_pfm(out)
             assert np.isfinite(x).all(), out
             plain = float(per_pixel_relmse(x, ref).mean())
+            flip_mean, params = flip_hdr(x, ref)
             row = [f"{name} {res[0]}×{res[1]}", label, spp, f"{t:.2f}",
-                   f"{relmse_dropped(x, ref):.5f}", f"{plain:.5f}", f"{flip_hdr(x, ref):.4f}"]
+                   f"{relmse_dropped(x, ref):.5f}", f"{plain:.5f}", f"{flip_mean:.4f}"]
             print(" | ".join(map(str, row)), flush=True)
             rows.append(row)
+        print(f"{name}: HDR-FLIP exposures {params['startExposure']:.2f} to "
+              f"{params['stopExposure']:.2f} in {params['numExposures']} steps, "
+              f"{params['ppd']:.1f} ppd, {params['tonemapper']}", flush=True)
     print(f"load after {machine.loadavg()}\n")
     print(report.table(["scene", "image", "spp", "time (s)", "relMSE, worst 1 % dropped",
                         "relMSE", "HDR-FLIP"], rows, "llrrrrr"))

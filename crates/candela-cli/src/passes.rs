@@ -6,7 +6,7 @@ use std::sync::atomic::AtomicBool;
 use std::time::Instant;
 
 use candela_core::aov::{render_aovs, AovKind, AovSet};
-use candela_core::desc::RenderSettings;
+use candela_core::desc::{FilterSampling, RenderSettings};
 use candela_core::Scene;
 use candela_denoise::{Denoiser, Guides, Images};
 use clap::{Args, ValueEnum};
@@ -35,7 +35,8 @@ pub struct PassArgs {
     /// Denoise the beauty with Intel Open Image Denoise 2.x (`pip install pyoidn`, or
     /// OIDN_DIR): `--denoise` guides it with the albedo and normal passes, prefiltered;
     /// `--denoise=color` uses the beauty alone. An EXR keeps the noisy beauty as the
-    /// `noisy` layer.
+    /// `noisy` layer. A filter wider than a pixel is importance-sampled, not splatted
+    /// (OIDN cannot denoise splatted noise), unless --filter-sampling is given.
     #[arg(long, value_name = "GUIDES", num_args = 0..=1, require_equals = true,
           default_missing_value = "guided")]
     denoise: Option<DenoiseMode>,
@@ -47,10 +48,20 @@ impl PassArgs {
         self.aov.is_some() || self.denoise.is_some()
     }
 
-    /// `--aov` over the scene's own `aov` list.
-    pub fn apply(&self, r: &mut RenderSettings) {
+    /// `--aov` over the scene's own `aov` list; with `--denoise`, filter importance
+    /// sampling unless `filter_sampling` was chosen on the command line (`explicit`).
+    ///
+    /// Open Image Denoise cannot denoise a splatted image: a sample weighted into every
+    /// pixel under a filter wider than a pixel correlates neighbouring pixels' noise,
+    /// which its `RT` filter then keeps ("not supported", OIDN's API documentation). Filter
+    /// importance sampling converges to the same image with each sample in one pixel, at
+    /// the AOV pass's own sample positions. The box filter renders the same either way.
+    pub fn apply(&self, r: &mut RenderSettings, explicit_filter_sampling: bool) {
         if let Some(set) = self.aov {
             r.aovs = set;
+        }
+        if self.denoise.is_some() && !explicit_filter_sampling {
+            r.filter_sampling = FilterSampling::Importance;
         }
     }
 
@@ -134,10 +145,12 @@ pub fn finish(
             width: s.width,
             height: s.height,
             color: &passes.beauty,
-            guides: guides
-                .as_ref()
-                .filter(|_| mode == DenoiseMode::Guided)
-                .map(|(albedo, normal)| Guides { albedo, normal }),
+            guides: guides.as_ref().filter(|_| mode == DenoiseMode::Guided).map(
+                |(albedo, normal)| Guides {
+                    albedo,
+                    normal: Some(normal),
+                },
+            ),
         };
         let denoised = denoiser
             .denoise(&images, threads)

@@ -220,7 +220,7 @@ impl RenderArgs {
         r.sampler = self.sampler.unwrap_or(r.sampler);
         r.filter_sampling = self.filter_sampling.unwrap_or(r.filter_sampling);
         r.isa = self.isa.unwrap_or(r.isa);
-        self.passes.apply(r);
+        self.passes.apply(r, self.filter_sampling.is_some());
         if self.focus_distance.is_some() || self.f_number.is_some() {
             let lens = desc.camera.lens.get_or_insert_with(LensDesc::default);
             if let Some(d) = self.focus_distance {

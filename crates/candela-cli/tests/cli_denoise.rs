@@ -183,3 +183,49 @@ fn denoised_render_is_finite_and_closer_to_the_reference() {
     let denoised_r: Vec<f32> = d.iter().map(|p| p[0]).collect();
     assert_eq!(channel(&channels, "R"), &denoised_r[..]);
 }
+
+/// `--denoise` renders a filter wider than a pixel by importance sampling (OIDN cannot
+/// denoise splatted noise): on the Mitsuba Cornell box with Mitsuba's default Gaussian,
+/// the noisy layer kept beside the denoised image is, bit for bit, the render with
+/// `--filter-sampling importance`, not the splatted default; `--filter-sampling splat`
+/// given on the command line still wins.
+#[test]
+fn denoise_importance_samples_a_wide_pixel_filter() {
+    if let Err(e) = candela_denoise::Denoiser::load() {
+        eprintln!("skipped: Open Image Denoise not found ({e})");
+        return;
+    }
+    let box_xml = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes/mitsuba-cornell.xml");
+    let xml = std::fs::read_to_string(box_xml).unwrap();
+    assert!(xml.contains(r#"<rfilter type="box"/>"#));
+    let dir = tempfile::tempdir().unwrap();
+    let scene = dir.path().join("gaussian.xml");
+    std::fs::write(&scene, xml.replace(r#"<rfilter type="box"/>"#, "")).unwrap();
+    let run = |out: &Path, extra: &[&str]| {
+        let mut args = vec!["render", s(&scene), "-o", s(out), "--res", "24x24"];
+        args.extend(["--spp", "4", "--seed", "3"]);
+        args.extend(extra);
+        let o = candela(&args);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    };
+    let red = |path: &Path| read_pfm(path).iter().map(|p| p[0]).collect::<Vec<f32>>();
+    let (importance, splat) = (dir.path().join("i.pfm"), dir.path().join("s.pfm"));
+    run(&importance, &["--filter-sampling", "importance"]);
+    run(&splat, &[]);
+    assert_ne!(
+        red(&importance),
+        red(&splat),
+        "the filter is wider than a pixel"
+    );
+    let denoised = dir.path().join("d.exr");
+    run(&denoised, &["--denoise"]);
+    assert_eq!(
+        channel(&exr_channels(&denoised), "noisy.R"),
+        &red(&importance)[..]
+    );
+    run(&denoised, &["--denoise", "--filter-sampling", "splat"]);
+    assert_eq!(
+        channel(&exr_channels(&denoised), "noisy.R"),
+        &red(&splat)[..]
+    );
+}

@@ -3,15 +3,17 @@
 //! OIDN is not linked: [`Denoiser::load`] finds `libOpenImageDenoise.so.2` through
 //! `OIDN_DIR` or a `pyoidn` installation (see [`locate`]) and resolves the dozen C
 //! functions Candela calls, so Candela builds and runs without it and only `--denoise`
-//! needs it. The filter is OIDN's `RT` (ray-traced images) on the CPU device, in HDR mode
-//! at high quality; with albedo and normal passes it first denoises each of them with the
-//! same filter and then tells the beauty's filter they are clean (`cleanAux`), the
+//! (and the Python package's `candela.denoise`) needs it. The filter is OIDN's `RT`
+//! (ray-traced images) on the CPU device at high quality, in HDR mode by default; with
+//! albedo (and normal) passes it by default first denoises each of them with the same
+//! filter and then tells the beauty's filter they are clean (`cleanAux`), the
 //! prefiltering OIDN's documentation prescribes for the highest quality.
 
 mod api;
 pub mod locate;
 
 use std::ffi::{c_int, c_void, CStr};
+use std::path::Path;
 
 use glam::Vec3;
 use libloading::Library;
@@ -19,13 +21,37 @@ use libloading::Library;
 use api::{Api, Device, Filter};
 pub use locate::INSTALL_HINT;
 
-/// The albedo and normal passes that guide the filter.
+/// The albedo and normal passes that guide the filter (OIDN takes a normal pass only
+/// beside an albedo pass).
 #[derive(Clone, Copy, Debug)]
 pub struct Guides<'a> {
     /// Albedo in [0, 1], row-major.
     pub albedo: &'a [Vec3],
     /// World- or camera-space normals in [−1, 1], row-major.
-    pub normal: &'a [Vec3],
+    pub normal: Option<&'a [Vec3]>,
+}
+
+/// How the filter reads its inputs.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Options {
+    /// The beauty is linear HDR radiance (any non-negative value); `false`: a display
+    /// image in [0, 1].
+    pub hdr: bool,
+    /// Denoise the guides first and tell the beauty's filter they are clean
+    /// (`cleanAux`), OIDN's high-quality recipe for guides rendered with the beauty's
+    /// noise (antialiasing, depth of field, rough reflections); `false`: pass them as they
+    /// are, for noise-free guides or a faster filter.
+    pub prefilter: bool,
+}
+
+impl Default for Options {
+    /// HDR, prefiltered guides: what `candela render --denoise` uses.
+    fn default() -> Options {
+        Options {
+            hdr: true,
+            prefilter: true,
+        }
+    }
 }
 
 /// What to denoise: a linear HDR image and, optionally, its guides.
@@ -51,7 +77,13 @@ impl Denoiser {
     /// Finds and loads the library. The error is one line; when the library is absent it
     /// says how to install it ([`INSTALL_HINT`]).
     pub fn load() -> Result<Denoiser, String> {
-        let (lib, source) = match locate::locate()? {
+        Denoiser::load_with(None)
+    }
+
+    /// [`Denoiser::load`], trying the `pyoidn` package folder `pyoidn` (e.g. the one the
+    /// running Python interpreter imports) right after `OIDN_DIR`.
+    pub fn load_with(pyoidn: Option<&Path>) -> Result<Denoiser, String> {
+        let (lib, source) = match locate::locate_with(pyoidn)? {
             locate::Location::File(path) => {
                 // SAFETY: loading runs the library's initializers; this is OIDN's library,
                 // found where OIDN installs it.
@@ -77,9 +109,20 @@ impl Denoiser {
         })
     }
 
-    /// Denoises `images` with OIDN's `RT` filter on the CPU, `threads` of them (0: all).
-    /// Returns the denoised beauty, row-major.
+    /// Denoises `images` with OIDN's `RT` filter on the CPU, `threads` of them (0: all),
+    /// with the default [`Options`] (HDR, guides prefiltered). Returns the denoised
+    /// beauty, row-major.
     pub fn denoise(&self, images: &Images, threads: usize) -> Result<Vec<Vec3>, String> {
+        self.denoise_with(images, Options::default(), threads)
+    }
+
+    /// [`Denoiser::denoise`] with the given [`Options`].
+    pub fn denoise_with(
+        &self,
+        images: &Images,
+        options: Options,
+        threads: usize,
+    ) -> Result<Vec<Vec3>, String> {
         let n = images.width as usize * images.height as usize;
         assert_eq!(images.color.len(), n, "the beauty has one value a pixel");
         let device = DeviceGuard::new(&self.api, threads)?;
@@ -97,31 +140,30 @@ impl Denoiser {
             device.run(
                 size,
                 &mut [(c"color", &mut color), (c"output", &mut output)],
+                options.hdr,
                 false,
             )?;
             return Ok(unflatten(&output));
         };
         assert_eq!(guides.albedo.len(), n, "the albedo has one value a pixel");
-        assert_eq!(
-            guides.normal.len(),
-            n,
-            "the normal pass has one value a pixel"
-        );
-        // Prefilter each guide in place, then tell the beauty's filter they are clean.
         let mut albedo = flatten(guides.albedo);
-        let mut normal = flatten(guides.normal);
-        device.prefilter(size, c"albedo", &mut albedo)?;
-        device.prefilter(size, c"normal", &mut normal)?;
-        device.run(
-            size,
-            &mut [
-                (c"color", &mut color),
-                (c"albedo", &mut albedo),
-                (c"normal", &mut normal),
-                (c"output", &mut output),
-            ],
-            true,
-        )?;
+        let mut normal = guides.normal.map(|normal| {
+            assert_eq!(normal.len(), n, "the normal pass has one value a pixel");
+            flatten(normal)
+        });
+        if options.prefilter {
+            // Denoise each guide in place, then tell the beauty's filter they are clean.
+            device.prefilter(size, c"albedo", &mut albedo)?;
+            if let Some(normal) = &mut normal {
+                device.prefilter(size, c"normal", normal)?;
+            }
+        }
+        let mut inputs = vec![(c"color", &mut color), (c"albedo", &mut albedo)];
+        if let Some(normal) = &mut normal {
+            inputs.push((c"normal", normal));
+        }
+        inputs.push((c"output", &mut output));
+        device.run(size, &mut inputs, options.hdr, options.prefilter)?;
         Ok(unflatten(&output))
     }
 }
@@ -177,11 +219,12 @@ impl<'a> DeviceGuard<'a> {
         self.execute(size, &[(name, ptr), (c"output", ptr)], |_| {})
     }
 
-    /// Runs the beauty's `RT` filter, HDR, over `images` (`output` among them).
+    /// Runs the beauty's `RT` filter over `images` (`output` among them).
     fn run(
         &self,
         size: (usize, usize),
         images: &mut [(&CStr, &mut Vec<f32>)],
+        hdr: bool,
         clean_aux: bool,
     ) -> Result<(), String> {
         let ptrs: Vec<(&CStr, *mut c_void)> = images
@@ -191,7 +234,7 @@ impl<'a> DeviceGuard<'a> {
         self.execute(size, &ptrs, |filter| {
             // SAFETY: a live filter and NUL-terminated names.
             unsafe {
-                (self.api.set_filter_bool)(filter, c"hdr".as_ptr(), true);
+                (self.api.set_filter_bool)(filter, c"hdr".as_ptr(), hdr);
                 (self.api.set_filter_bool)(filter, c"cleanAux".as_ptr(), clean_aux);
             }
         })

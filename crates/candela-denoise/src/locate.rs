@@ -47,6 +47,13 @@ fn first_file(dir: &Path) -> Option<PathBuf> {
 /// otherwise the active virtual environment's `pyoidn`, then the `pyoidn` that `python3`
 /// imports, then the system's loader.
 pub fn locate() -> Result<Location, String> {
+    locate_with(None)
+}
+
+/// [`locate`], trying the `pyoidn` package folder `pyoidn` right after `OIDN_DIR` (the
+/// Python package passes the one its own interpreter imports, which `python3` on the
+/// path may not see).
+pub fn locate_with(pyoidn: Option<&Path>) -> Result<Location, String> {
     if let Some(dir) = env::var_os("OIDN_DIR").filter(|d| !d.is_empty()) {
         let dir = PathBuf::from(dir);
         if dir.is_file() {
@@ -58,6 +65,9 @@ pub fn locate() -> Result<Location, String> {
                 dir.display()
             )
         });
+    }
+    if let Some(found) = pyoidn.and_then(first_file) {
+        return Ok(Location::File(found));
     }
     if let Some(found) = virtual_env_pyoidn().or_else(python_pyoidn) {
         return Ok(Location::File(found));

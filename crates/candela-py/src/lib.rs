@@ -1,7 +1,9 @@
 //! `candela._candela`: the native half of the Python package. The Python half
 //! (`python/candela/__init__.py`) turns pixels into NumPy arrays and draws the progress
-//! bar; this half loads scenes, renders with the GIL released, writes images and reads,
-//! writes and merges film parts.
+//! bar; this half loads scenes, renders with the GIL released, writes images, reads,
+//! writes and merges film parts, and denoises images ([`denoise`]).
+
+mod denoise;
 
 use std::ops::Range;
 use std::path::PathBuf;
@@ -12,7 +14,7 @@ use candela_cli::merge::{merge_parts, NamedPart};
 use candela_cli::output::{write_image, LinearImage};
 use candela_cli::part::{read_part, write_part, PartInfo};
 use candela_cli::tonemap::{DisplayTransform, Tonemap};
-use candela_core::desc::SceneDesc;
+use candela_core::desc::{FilterSampling, SceneDesc};
 use candela_core::film::Film as CoreFilm;
 use candela_core::integrator;
 use clap::ValueEnum;
@@ -80,6 +82,28 @@ impl Scene {
             self.path, r.width, r.height, r.spp
         )
     }
+}
+
+impl Scene {
+    /// The description with the render's own spp and seed overrides.
+    fn with_overrides(&self, spp: Option<u32>, seed: Option<u64>) -> SceneDesc {
+        let mut desc = self.desc.clone();
+        if let Some(spp) = spp {
+            desc.render.spp = spp;
+        }
+        if let Some(seed) = seed {
+            desc.render.seed = seed;
+        }
+        desc
+    }
+}
+
+/// A pool of `threads` workers (default: one a core).
+fn thread_pool(threads: Option<usize>) -> PyResult<rayon::ThreadPool> {
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(threads.unwrap_or(0))
+        .build()
+        .map_err(|e| PyValueError::new_err(format!("cannot start threads: {e}")))
 }
 
 /// The film of a range of sample indices: exact per-pixel sums that merge bit for bit.
@@ -217,8 +241,11 @@ fn load(
 
 /// Renders `samples` (default 0..spp) of the scene with optional spp and seed overrides.
 /// `progress(done, total)` is called from the waiting thread (with the GIL) every 50 ms.
+/// `filter_sampling`: "splat" or "importance" over the scene's own.
 #[pyfunction]
-#[pyo3(signature = (scene, spp=None, seed=None, samples=None, threads=None, progress=None))]
+#[pyo3(signature = (scene, spp=None, seed=None, samples=None, threads=None, progress=None,
+                    filter_sampling=None))]
+#[allow(clippy::too_many_arguments)]
 fn render_film(
     py: Python<'_>,
     scene: &Scene,
@@ -227,13 +254,18 @@ fn render_film(
     samples: Option<(u32, u32)>,
     threads: Option<usize>,
     progress: Option<PyObject>,
+    filter_sampling: Option<&str>,
 ) -> PyResult<Film> {
-    let mut desc = scene.desc.clone();
-    if let Some(spp) = spp {
-        desc.render.spp = spp;
-    }
-    if let Some(seed) = seed {
-        desc.render.seed = seed;
+    let mut desc = scene.with_overrides(spp, seed);
+    match filter_sampling {
+        None => {}
+        Some("splat") => desc.render.filter_sampling = FilterSampling::Splat,
+        Some("importance") => desc.render.filter_sampling = FilterSampling::Importance,
+        Some(other) => {
+            return Err(PyValueError::new_err(format!(
+                "filter_sampling must be \"splat\" or \"importance\", got {other:?}"
+            )))
+        }
     }
     let total_spp = desc.render.spp;
     let range: Range<u32> = match samples {
@@ -248,10 +280,7 @@ fn render_film(
     let built = py
         .allow_threads(|| candela_core::build::build(&desc))
         .map_err(|e| SceneError::new_err(e.to_string()))?;
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(threads.unwrap_or(0))
-        .build()
-        .map_err(|e| PyValueError::new_err(format!("cannot start threads: {e}")))?;
+    let pool = thread_pool(threads)?;
     let (w, h) = (built.settings.width as u64, built.settings.height as u64);
     let total = w * h * range.len() as u64;
     let cancel = AtomicBool::new(false);
@@ -425,6 +454,7 @@ fn _candela(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<Film>()?;
     m.add("SceneError", m.py().get_type::<SceneError>())?;
     m.add("MergeError", m.py().get_type::<MergeError>())?;
+    m.add("DenoiseError", m.py().get_type::<denoise::DenoiseError>())?;
     m.add_function(wrap_pyfunction!(load, m)?)?;
     m.add_function(wrap_pyfunction!(render_film, m)?)?;
     m.add_function(wrap_pyfunction!(merge, m)?)?;
@@ -432,5 +462,7 @@ fn _candela(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(_film_from_bytes, m)?)?;
     m.add_function(wrap_pyfunction!(write_pixels, m)?)?;
     m.add_function(wrap_pyfunction!(info, m)?)?;
+    m.add_function(wrap_pyfunction!(denoise::denoise, m)?)?;
+    m.add_function(wrap_pyfunction!(denoise::render_aovs, m)?)?;
     Ok(())
 }

@@ -1,8 +1,12 @@
-"""Shared fixtures: a small scene written to a temp folder, and the `candela` binary."""
+"""Shared fixtures: a small scene written to a temp folder, the `candela` binary, and a
+check that a native call releases the GIL."""
 
 import os
 import shutil
+import threading
+import time
 from pathlib import Path
+from typing import Callable
 
 import pytest
 
@@ -33,3 +37,38 @@ def candela_bin() -> Path:
     if found:
         return Path(found)
     pytest.skip("skipped: no candela binary (cargo build --release first)")
+
+
+def _assert_releases_the_gil(call: Callable[[int], None]) -> None:
+    """Calls ``call(0)``, ``call(1)``, … (each step twice the work of the last) until one
+    call takes 0.3 s (at most 16 steps), while another thread ticks every 10 ms; that
+    thread must tick throughout the long call. A thread starved of the GIL would tick
+    about once per call."""
+    ticks = []
+    done = threading.Event()
+
+    def tick():
+        while not done.is_set():
+            ticks.append(time.monotonic())
+            time.sleep(0.01)
+
+    t = threading.Thread(target=tick)
+    t.start()
+    try:
+        for step in range(16):
+            start = time.monotonic()
+            call(step)
+            elapsed = time.monotonic() - start
+            if elapsed > 0.3:
+                break
+    finally:
+        done.set()
+        t.join()
+    during = [x for x in ticks if start <= x <= start + elapsed]
+    assert elapsed > 0.2 and len(during) >= 0.2 * elapsed / 0.01, (elapsed, len(during))
+
+
+@pytest.fixture
+def assert_releases_the_gil() -> Callable[[Callable[[int], None]], None]:
+    """See `_assert_releases_the_gil`."""
+    return _assert_releases_the_gil

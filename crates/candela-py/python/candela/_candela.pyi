@@ -10,6 +10,9 @@ class SceneError(Exception):
 class MergeError(Exception):
     """Films of other scenes, resolutions, seeds or spp, or overlapping ranges."""
 
+class DenoiseError(RuntimeError):
+    """Open Image Denoise is absent (the message says ``pip install pyoidn``) or failed."""
+
 class Scene:
     """A loaded scene description."""
 
@@ -61,6 +64,7 @@ def render_film(
     samples: Optional[Tuple[int, int]] = None,
     threads: Optional[int] = None,
     progress: Optional[Callable[[int, int], Any]] = None,
+    filter_sampling: Optional[str] = None,
 ) -> Film: ...
 def merge(films: Sequence[Film]) -> Film: ...
 def read_film(path: str) -> Film: ...
@@ -75,3 +79,19 @@ def write_pixels(
     gamma: Optional[float] = None,
 ) -> None: ...
 def info(scene: Scene) -> Dict[str, Any]: ...
+def denoise(
+    color: bytes,
+    width: int,
+    height: int,
+    albedo: Optional[bytes] = None,
+    normal: Optional[bytes] = None,
+    prefilter: bool = True,
+    hdr: bool = True,
+    threads: Optional[int] = None,
+    pyoidn: Optional[str] = None,
+) -> bytes:
+    """Float32 RGB bytes (row-major) denoised by OIDN's RT filter; see ``candela.denoise``."""
+def render_aovs(
+    scene: Scene, spp: Optional[int] = None, seed: Optional[int] = None, threads: Optional[int] = None
+) -> Dict[str, bytes]:
+    """Float32 bytes (row-major) of the "albedo", "normal" (3 a pixel) and "depth" passes."""
