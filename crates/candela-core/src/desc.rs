@@ -678,6 +678,23 @@ pub enum Isa {
     V3,
 }
 
+/// How the acceleration structure stores its leaves' primitives (see
+/// [`crate::accel::LeafLayout`]). Its names in scene files and on the command line are
+/// `auto`, `inline` and `compact`. Every choice renders the same pixels, bit for bit;
+/// only speed and memory differ.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum AccelStorage {
+    /// Inline below [`crate::accel::INDEXED_FROM`] primitives, compact from there on.
+    #[default]
+    Auto,
+    /// Each leaf a block with its vertices copied in: the fastest.
+    Inline,
+    /// Each primitive as indices into a shared vertex array: about a quarter of the
+    /// memory.
+    Compact,
+}
+
 /// Default number of RIS candidates, chosen by `bench/many_lights`.
 pub const DEFAULT_RIS_CANDIDATES: u32 = 2;
 
@@ -714,6 +731,8 @@ pub struct RenderSettings {
     /// Which compiled copy of the render loop runs; it must be supported by the CPU
     /// ([`Isa::is_supported`]).
     pub isa: Isa,
+    /// How the acceleration structure stores its leaves.
+    pub accel: AccelStorage,
     /// Passes rendered beside the beauty image (see [`crate::aov`]).
     pub aovs: crate::aov::AovSet,
 }
@@ -770,6 +789,7 @@ impl Default for RenderSettings {
             filter: PixelFilterDesc::Box,
             filter_sampling: FilterSampling::default(),
             isa: Isa::Auto,
+            accel: AccelStorage::Auto,
             aovs: crate::aov::AovSet::NONE,
         }
     }
