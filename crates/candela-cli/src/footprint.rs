@@ -1,6 +1,7 @@
 //! Where a big scene's time and memory go: the process's peak resident memory and the
 //! bytes the built scene holds, for the render summary and `candela info`.
 
+use candela_core::accel::LeafLayout;
 use candela_core::scene::{Mesh, Scene};
 
 /// The process's peak resident set so far in bytes (`VmHWM` of `/proc/self/status`), or
@@ -53,6 +54,20 @@ fn mesh_bytes(m: &Mesh) -> usize {
         + size_of_val(&m.face_normals[..])
 }
 
+/// The peak after loading and after building, and the process's peak now: which phase
+/// set it ("peak memory 817.8 MB (load 288.0 MB, build 817.8 MB)").
+pub fn peaks(load: Option<u64>, build: Option<u64>) -> String {
+    let Some(total) = peak_resident_bytes() else {
+        return "unknown".into();
+    };
+    let phase = |name: &str, bytes: Option<u64>| bytes.map(|b| format!("{name} {}", megabytes(b)));
+    let phases: Vec<String> = [phase("load", load), phase("build", build)]
+        .into_iter()
+        .flatten()
+        .collect();
+    format!("{} ({})", megabytes(total), phases.join(", "))
+}
+
 /// "123.4 MB".
 pub fn megabytes(bytes: u64) -> String {
     format!("{:.1} MB", bytes as f64 / 1e6)
@@ -62,8 +77,12 @@ pub fn megabytes(bytes: u64) -> String {
 pub fn describe(scene: &Scene) -> String {
     let m = SceneMemory::of(scene);
     let triangles = scene.stored_triangle_count().max(1);
+    let leaves = match scene.accel.layout().leaves {
+        LeafLayout::Inline => "inline",
+        LeafLayout::Indexed => "compact",
+    };
     format!(
-        "{} ({:.0} bytes a triangle: meshes {}, acceleration {})",
+        "{} ({:.0} bytes a triangle: meshes {}, acceleration {}, {leaves} leaves)",
         megabytes(m.total() as u64),
         m.total() as f64 / triangles as f64,
         megabytes(m.meshes as u64),

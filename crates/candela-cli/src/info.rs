@@ -9,15 +9,19 @@ use crate::UserError;
 
 pub fn run(path: &Path, load: &LoadArgs) -> Result<(), UserError> {
     let desc = load.load(path)?;
-    let scene = candela_core::build::build(&desc)?;
+    // What is printed of the description, taken before the build moves its meshes.
+    let shapes = desc.shapes.len();
+    let names: Vec<String> = desc.materials.iter().map(|m| m.name.clone()).collect();
+    let c = desc.camera.clone();
+    let s = desc.render.clone();
+    let scene = candela_core::build::build_owned(desc)?;
     let memory = crate::footprint::describe(&scene);
-    let s = &desc.render;
     let b = scene.bounds();
     let count = |f: fn(&Light) -> bool| scene.lights.iter().filter(|l| f(l)).count();
     println!("scene      {}", path.display());
     println!(
         "shapes     {} ({} meshes, {} spheres)",
-        desc.shapes.len(),
+        shapes,
         scene.meshes.len(),
         scene.spheres.len()
     );
@@ -47,9 +51,7 @@ pub fn run(path: &Path, load: &LoadArgs) -> Result<(), UserError> {
             print_environment(env);
         }
     }
-    let names: Vec<&str> = desc.materials.iter().map(|m| m.name.as_str()).collect();
     println!("materials  {} ({})", names.len(), names.join(", "));
-    let c = &desc.camera;
     let view = match c.ortho_height {
         Some(h) => format!("orthographic, {h} high"),
         None => format!("vertical fov {}°", c.vertical_fov_deg()),

@@ -11,8 +11,8 @@ use std::sync::Arc;
 use std::time::Instant;
 
 use candela_core::desc::{
-    ApertureSizeDesc, EnvironmentDesc, EnvironmentMapDesc, FilterSampling, FocusDesc, Isa,
-    LampSampling, LensDesc, LightSamplerKind, MisMode, SamplerKind, SceneDesc, Span,
+    AccelStorage, ApertureSizeDesc, EnvironmentDesc, EnvironmentMapDesc, FilterSampling, FocusDesc,
+    Isa, LampSampling, LensDesc, LightSamplerKind, MisMode, SamplerKind, SceneDesc, Span,
 };
 use candela_core::integrator;
 use clap::Args;
@@ -132,6 +132,12 @@ pub struct RenderArgs {
     /// baseline (any x86-64) or v3 (x86-64-v3: AVX2, FMA, BMI2). Same pixels with each.
     #[arg(long, value_parser = parse_name::<Isa>)]
     isa: Option<Isa>,
+    /// How the ray-tracing structure stores its triangles: auto (the default: inline
+    /// below 4.2 million primitives, compact from there), inline (each leaf's vertices
+    /// copied in, the fastest) or compact (indices into the meshes' vertices, about a
+    /// quarter of the memory). Same pixels with each.
+    #[arg(long, value_parser = parse_name::<AccelStorage>)]
+    accel: Option<AccelStorage>,
     /// Focus distance of a thin lens, in scene units along the view axis (a pinhole
     /// scene also needs --f-number to blur).
     #[arg(long, allow_negative_numbers = true)]
@@ -220,6 +226,7 @@ impl RenderArgs {
         r.sampler = self.sampler.unwrap_or(r.sampler);
         r.filter_sampling = self.filter_sampling.unwrap_or(r.filter_sampling);
         r.isa = self.isa.unwrap_or(r.isa);
+        r.accel = self.accel.unwrap_or(r.accel);
         self.passes.apply(r, self.filter_sampling.is_some());
         if self.focus_distance.is_some() || self.f_number.is_some() {
             let lens = desc.camera.lens.get_or_insert_with(LensDesc::default);
@@ -330,6 +337,7 @@ pub fn run(args: RenderArgs) -> Result<ExitCode, UserError> {
     let loaded = Instant::now();
     let mut desc = args.load.load(&args.scene)?;
     let load_s = loaded.elapsed().as_secs_f64();
+    let load_peak = crate::footprint::peak_resident_bytes();
     args.apply_overrides(&mut desc);
     if !desc.render.isa.is_supported() {
         // Auto and baseline run anywhere: only v3 can be refused.
@@ -347,6 +355,7 @@ pub fn run(args: RenderArgs) -> Result<ExitCode, UserError> {
     let built = Instant::now();
     let scene = candela_core::build::build_owned(desc)?;
     let build_s = built.elapsed().as_secs_f64();
+    let build_peak = crate::footprint::peak_resident_bytes();
     let s = &scene.settings;
 
     let threads = args.threads.unwrap_or(0);
@@ -416,8 +425,7 @@ pub fn run(args: RenderArgs) -> Result<ExitCode, UserError> {
     println!(
         "load {load_s:.2} s, build {build_s:.2} s, render {elapsed:.2} s; scene {}; peak memory {}",
         crate::footprint::describe(&scene),
-        crate::footprint::peak_resident_bytes()
-            .map_or("unknown".into(), crate::footprint::megabytes)
+        crate::footprint::peaks(load_peak, build_peak)
     );
     let rejected = result.film.rejected_samples();
     if rejected > 0 {

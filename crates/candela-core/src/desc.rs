@@ -17,7 +17,7 @@ mod builders;
 mod media;
 
 pub use crate::options::{
-    FilterSampling, Isa, LampSampling, LightSamplerKind, MisMode, SamplerKind,
+    AccelStorage, FilterSampling, Isa, LampSampling, LightSamplerKind, MisMode, SamplerKind,
 };
 pub use media::*;
 
@@ -620,6 +620,8 @@ pub struct RenderSettings {
     /// Which compiled copy of the render loop runs; it must be supported by the CPU
     /// ([`Isa::is_supported`]).
     pub isa: Isa,
+    /// How the acceleration structure stores its leaves.
+    pub accel: AccelStorage,
     /// Passes rendered beside the beauty image (see [`crate::aov`]).
     pub aovs: AovSet,
 }
@@ -658,6 +660,7 @@ impl Default for RenderSettings {
             filter: PixelFilterDesc::Box,
             filter_sampling: FilterSampling::default(),
             isa: Isa::Auto,
+            accel: AccelStorage::Auto,
             aovs: AovSet::NONE,
         }
     }

@@ -18,9 +18,10 @@
 
 use glam::{Mat3, Mat4, Vec3, Vec4};
 
-use crate::accel::Accel;
+use crate::accel::{Accel, AccelLayout, Geometry, LeafLayout, NodeLayout, Simd, TriangleMesh};
 use crate::alpha::AlphaMask;
 use crate::bvh::Bvh;
+use crate::desc::AccelStorage;
 use crate::geometry::{Aabb, Ray, TriangleHit};
 use crate::material::MaterialId;
 use crate::scene::Mesh;
@@ -123,9 +124,10 @@ pub struct Instances {
 }
 
 impl Instances {
-    /// Builds a BLAS per mesh and the TLAS over the instances. `filtered[m]` says whether
-    /// hits on mesh `m` must pass the filter (some instance of it has alpha).
-    pub fn new(meshes: Vec<Mesh>, instances: Vec<Instance>) -> Instances {
+    /// Builds a BLAS per mesh, its leaves as `storage` asks, and the TLAS over the
+    /// instances. Hits on a mesh must pass the filter where some instance of it has
+    /// alpha.
+    pub fn new(meshes: Vec<Mesh>, instances: Vec<Instance>, storage: AccelStorage) -> Instances {
         let mut filtered = vec![false; meshes.len()];
         for i in &instances {
             filtered[i.mesh as usize] |= i.alpha.is_some();
@@ -133,11 +135,18 @@ impl Instances {
         let blas: Vec<Accel> = meshes
             .iter()
             .zip(&filtered)
-            .map(|(m, &f)| {
-                let shapes: Vec<_> = (0..m.indices.len() as u32)
-                    .map(|t| crate::accel::Shape::Triangle(m.vertices(t)))
-                    .collect();
-                Accel::build(&shapes, |_| f)
+            .map(|(m, &filtered)| {
+                let mesh = TriangleMesh {
+                    positions: &m.positions,
+                    indices: &m.indices,
+                    filtered,
+                };
+                let geometry = Geometry::new(vec![mesh], Vec::new());
+                let layout = AccelLayout {
+                    nodes: NodeLayout::Full,
+                    leaves: LeafLayout::choose(storage, geometry.len()),
+                };
+                Accel::build_geometry(&geometry, Simd::best(), layout)
             })
             .collect();
         let boxes: Vec<Aabb> = instances

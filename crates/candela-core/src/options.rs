@@ -125,6 +125,23 @@ pub enum FilterSampling {
     Importance,
 }
 
+/// How the acceleration structure stores its leaves' primitives (see
+/// [`crate::accel::LeafLayout`]). Its names in scene files and on the command line are
+/// `auto`, `inline` and `compact`. Every choice renders the same pixels, bit for bit;
+/// only speed and memory differ.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum AccelStorage {
+    /// Inline below [`crate::accel::INDEXED_FROM`] primitives, compact from there on.
+    #[default]
+    Auto,
+    /// Each leaf a block with its vertices copied in: the fastest.
+    Inline,
+    /// Each primitive as indices into a shared vertex array: about a quarter of the
+    /// memory.
+    Compact,
+}
+
 /// One pass. Its name in scene files and on the command line is its lowercase name.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, serde::Deserialize)]
 #[serde(rename_all = "lowercase")]

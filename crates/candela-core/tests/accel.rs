@@ -15,12 +15,17 @@
 //!
 //! Every SIMD kernel set the CPU has (`Simd::available`, always including the scalar
 //! fallback) is checked the same way, with both node layouts (full planes and quantized
-//! boxes), and each must return exactly what the scalar one of its layout returns (same
-//! primitive even in ties, same t and barycentric bits): their box tests give the same
-//! bits, so they walk the tree in the same order. Across layouts the order differs
-//! (quantized boxes are entered a little earlier), so there only ties may differ.
+//! boxes) and both leaf layouts (inline blocks and indexed records), and each must return
+//! exactly what the scalar kernels with inline leaves and the same node layout return
+//! (same primitive even in ties, same t and barycentric bits): their box tests give the
+//! same bits, so they walk the tree in the same order, and an indexed leaf is tested as
+//! the block it gathers. Across node layouts the order differs (quantized boxes are
+//! entered a little earlier), so there only ties may differ.
 
-use candela_core::accel::{accept_all, Accel, Hit, NodeLayout, Shape, Simd};
+use candela_core::accel::{
+    accept_all, Accel, AccelLayout, Geometry, Hit, LeafLayout, NodeLayout, Shape, Simd,
+    TriangleMesh,
+};
 use candela_core::bvh::Bvh;
 use candela_core::geometry::{intersect_sphere, Aabb, Ray, WatertightRay};
 use candela_core::sampler::Pcg32;
@@ -114,7 +119,7 @@ fn random_rays(rng: &mut Pcg32, shapes: &[Shape], bounds: Aabb, n: usize) -> Vec
 /// Checks every ray against brute force and the binary BVH, with every kernel set;
 /// returns how many hit.
 fn check_scene(name: &str, shapes: &[Shape], rays: &[Ray], rng: &mut Pcg32) -> usize {
-    let layouts = [NodeLayout::Full, NodeLayout::Quantized];
+    let layouts = all_layouts();
     let accels: Vec<Vec<Accel>> = layouts
         .iter()
         .map(|&layout| {
@@ -136,8 +141,10 @@ fn check_scene(name: &str, shapes: &[Shape], rays: &[Ray], rng: &mut Pcg32) -> u
         let brute = brute_force(shapes, ray, t_max);
         let old = binary.intersect(ray, t_max, |i, t| test_shape(&shapes[i as usize], ray, t));
         for accel in accels.iter().flatten() {
-            // Within a layout every kernel walks the same order: the same hit, bit for bit.
-            let scalar = accels[(accel.layout() == NodeLayout::Quantized) as usize][0]
+            // Within a node layout every kernel and leaf layout walks the same order: the
+            // same hit, bit for bit.
+            let nodes = accel.layout().nodes;
+            let scalar = accels[layouts.iter().position(|l| *l == nodes.into()).unwrap()][0]
                 .intersect(ray, t_max, accept_all);
             let simd = (accel.layout(), accel.simd());
             let new = accel.intersect(ray, t_max, accept_all);
@@ -181,11 +188,21 @@ fn check_scene(name: &str, shapes: &[Shape], rays: &[Ray], rng: &mut Pcg32) -> u
     hits
 }
 
-/// Every kernel set the CPU has, with each node layout.
-fn kernels_and_layouts() -> Vec<(Simd, NodeLayout)> {
+/// Each node layout with each leaf layout.
+fn all_layouts() -> Vec<AccelLayout> {
+    [NodeLayout::Full, NodeLayout::Quantized]
+        .into_iter()
+        .flat_map(|nodes| {
+            [LeafLayout::Inline, LeafLayout::Indexed].map(|leaves| AccelLayout { nodes, leaves })
+        })
+        .collect()
+}
+
+/// Every kernel set the CPU has, with each layout.
+fn kernels_and_layouts() -> Vec<(Simd, AccelLayout)> {
     Simd::available()
         .into_iter()
-        .flat_map(|s| [(s, NodeLayout::Full), (s, NodeLayout::Quantized)])
+        .flat_map(|s| all_layouts().into_iter().map(move |l| (s, l)))
         .collect()
 }
 
@@ -401,4 +418,91 @@ fn rejected_hits_are_as_if_the_triangles_were_not_there() {
             calls.get()
         );
     }
+}
+
+/// A scene given by reference to its meshes' shared vertex arrays (`Geometry`: an
+/// indexed height field, an alpha-flagged indexed soup and spheres) builds the same
+/// structure as the same primitives given one by one: with either leaf layout and every
+/// kernel, each ray's nearest hit is the same primitive with the same bits, its any-hit
+/// answer the same, and a flagged triangle reaches the filter with the same id.
+#[test]
+fn shared_vertices_give_the_hits_of_the_primitives_one_by_one() {
+    let n = 40;
+    let grid: Vec<Vec3> = (0..=n)
+        .flat_map(|i| (0..=n).map(move |j| (i, j)))
+        .map(|(i, j)| {
+            let (x, z) = (i as f32 / n as f32, j as f32 / n as f32);
+            Vec3::new(x, 0.1 * (9.0 * x).sin() * (7.0 * z).cos(), z) * 4.0
+        })
+        .collect();
+    let at = |i: usize, j: usize| (i * (n + 1) + j) as u32;
+    let field: Vec<[u32; 3]> = (0..n)
+        .flat_map(|i| (0..n).map(move |j| (i, j)))
+        .flat_map(|(i, j)| {
+            [
+                [at(i, j), at(i + 1, j), at(i + 1, j + 1)],
+                [at(i, j), at(i + 1, j + 1), at(i, j + 1)],
+            ]
+        })
+        .collect();
+    let mut rng = Pcg32::new(40, 1);
+    let soup_points: Vec<Vec3> = (0..600).map(|_| v3(&mut rng) * 4.0).collect();
+    let soup: Vec<[u32; 3]> = (0..400)
+        .map(|_| [0; 3].map(|_| rng.next_u32() % soup_points.len() as u32))
+        .collect();
+    let spheres: Vec<(Vec3, f32)> = (0..30)
+        .map(|_| (v3(&mut rng) * 4.0, 0.05 + 0.2 * rng.uniform_f32()))
+        .collect();
+    let geometry = Geometry::new(
+        vec![
+            TriangleMesh {
+                positions: &grid,
+                indices: &field,
+                filtered: false,
+            },
+            TriangleMesh {
+                positions: &soup_points,
+                indices: &soup,
+                filtered: true,
+            },
+        ],
+        spheres.clone(),
+    );
+    let shapes: Vec<Shape> = (0..geometry.len() as u32)
+        .map(|i| geometry.shape(i))
+        .collect();
+    let filtered = |i: u32| geometry.filtered(i);
+    // Rejects a flagged triangle when its id is odd.
+    let even = |i: u32, _: &_| i.is_multiple_of(2);
+    let rays = random_rays(&mut rng, &shapes, bounds_of(&shapes), 6000);
+    let (mut hits, mut filtered_hits) = (0, 0);
+    for (simd, layout) in kernels_and_layouts() {
+        let one_by_one = Accel::build_layout(&shapes, filtered, simd, layout);
+        let shared = Accel::build_geometry(&geometry, simd, layout);
+        assert_eq!(shared.layout(), layout);
+        for (k, ray) in rays.iter().enumerate() {
+            let t_max = if k % 4 == 0 { 3.0 } else { f32::INFINITY };
+            let bits = |h: Option<Hit>| h.map(|h| (h.prim, [h.t, h.b1, h.b2].map(f32::to_bits)));
+            let a = one_by_one.intersect(ray, t_max, even);
+            assert_eq!(
+                bits(shared.intersect(ray, t_max, even)),
+                bits(a),
+                "{simd:?} {layout:?} ray {k}"
+            );
+            assert_eq!(
+                shared.occluded(ray, t_max, even),
+                one_by_one.occluded(ray, t_max, even),
+                "{simd:?} {layout:?} ray {k}"
+            );
+            hits += a.is_some() as usize;
+            filtered_hits += a.is_some_and(|h| filtered(h.prim)) as usize;
+        }
+    }
+    // Thresholds: most rays aim at a primitive; the soup is a fifth of the triangles.
+    let runs = kernels_and_layouts().len();
+    assert!(hits > runs * 2000, "only {hits} hits in {runs} runs");
+    assert!(
+        filtered_hits > runs * 100,
+        "only {filtered_hits} filtered hits"
+    );
 }

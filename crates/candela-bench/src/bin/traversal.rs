@@ -15,8 +15,9 @@
 //! `bench/traversal.py`, which traces the same rays with Embree and compares.
 //!
 //! `CANDELA_SIMD=scalar|sse|avx2` forces the kernels (default: the best the CPU has; the
-//! JSON line says which ran), `CANDELA_NODES=full|quantized` the BVH's node layout
-//! (default: the library's).
+//! JSON line says which ran), `CANDELA_NODES=full|quantized` the BVH's node layout and
+//! `CANDELA_LEAVES=inline|indexed` its leaf layout (default: the library's; indexed
+//! leaves here get three vertices of their own a triangle, stored in leaf order).
 //!
 //! `traversal build [TRIANGLES]` times the BVH build of a generated displaced-sphere mesh
 //! (default 10⁶ triangles) on the rayon pool (`RAYON_NUM_THREADS=2` for two cores).
@@ -26,7 +27,7 @@ use std::path::Path;
 use std::time::Instant;
 
 use candela_bench::cpu_seconds;
-use candela_core::accel::{Accel, NodeLayout, Shape, Simd};
+use candela_core::accel::{Accel, AccelLayout, LeafLayout, NodeLayout, Shape, Simd};
 use candela_core::geometry::{Ray, TriangleHit};
 use candela_core::math::{offset_ray_origin, Frame};
 use candela_core::sampler::Pcg32;
@@ -352,14 +353,22 @@ fn simd_from_env() -> Simd {
     }
 }
 
-/// The node layout: `CANDELA_NODES=full|quantized`, else the library's default.
-fn layout_from_env() -> NodeLayout {
-    match std::env::var("CANDELA_NODES").as_deref() {
+/// The layout: `CANDELA_NODES=full|quantized` and `CANDELA_LEAVES=inline|indexed`,
+/// else the library's defaults.
+fn layout_from_env() -> AccelLayout {
+    let nodes = match std::env::var("CANDELA_NODES").as_deref() {
         Ok("full") => NodeLayout::Full,
         Ok("quantized") => NodeLayout::Quantized,
         Ok(other) => panic!("CANDELA_NODES={other:?}: full or quantized"),
         Err(_) => NodeLayout::default(),
-    }
+    };
+    let leaves = match std::env::var("CANDELA_LEAVES").as_deref() {
+        Ok("inline") => LeafLayout::Inline,
+        Ok("indexed") => LeafLayout::Indexed,
+        Ok(other) => panic!("CANDELA_LEAVES={other:?}: inline or indexed"),
+        Err(_) => LeafLayout::default(),
+    };
+    AccelLayout { nodes, leaves }
 }
 
 /// The fastest of `runs` timings of `f`, in seconds: the least disturbed by other load.

@@ -62,20 +62,32 @@ struct Lanes {
 }
 
 impl Block {
+    /// No primitive: NaN vertices in every lane.
+    const EMPTY: Block = Block {
+        v: [[[f32::NAN; LANES]; 3]; 3],
+        id: [0; LANES],
+    };
+
     /// Packs up to eight primitives given as (vertices, id with flags).
+    #[cfg(test)]
     pub fn new(prims: &[([Vec3; 3], u32)]) -> Block {
-        debug_assert!(prims.len() <= LANES);
-        let mut b = Block {
-            v: [[[f32::NAN; LANES]; 3]; 3],
-            id: [0; LANES],
-        };
-        for (lane, (v, id)) in prims.iter().enumerate() {
+        Block::gather(prims.len(), |lane| prims[lane])
+    }
+
+    /// Packs the `count` (at most eight) primitives `prim(lane)` gives as (vertices, id
+    /// with flags): how an indexed leaf becomes the block the inline layout holds.
+    #[inline(always)]
+    pub fn gather(count: usize, prim: impl Fn(usize) -> ([Vec3; 3], u32)) -> Block {
+        debug_assert!(count <= LANES);
+        let mut b = Block::EMPTY;
+        for lane in 0..count.min(LANES) {
+            let (v, id) = prim(lane);
             for (vertex, p) in v.iter().enumerate() {
-                for axis in 0..3 {
-                    b.v[vertex][axis][lane] = p[axis];
-                }
+                b.v[vertex][0][lane] = p.x;
+                b.v[vertex][1][lane] = p.y;
+                b.v[vertex][2][lane] = p.z;
             }
-            b.id[lane] = *id;
+            b.id[lane] = id;
         }
         b
     }

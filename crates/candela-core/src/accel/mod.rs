@@ -15,11 +15,16 @@
 //! where the CPU has them, else SSE; [`Accel::build_for`] forces one (the tests run each the CPU has
 //! against the scalar one). Every kernel finds the same hits, bit for bit.
 //!
-//! [`NodeLayout`] picks the wide nodes: full planes (the default) or quantized boxes
-//! (half the node memory; [`Accel::build_layout`]).
+//! [`AccelLayout`] picks the wide nodes, full planes (the default) or quantized boxes
+//! (half the node memory), and the leaves: inline blocks (the default) or indexed
+//! records gathered into a block when a ray reaches them (a quarter of the memory;
+//! [`LeafLayout::auto`] chooses them for big scenes). Every layout finds the same hits.
 
 mod block;
+mod geometry;
+mod indexed;
 mod lanes;
+mod layout;
 mod sphere;
 
 use glam::Vec3;
@@ -29,8 +34,11 @@ use crate::bvh::{Avx2Boxes, SseBoxes};
 use crate::bvh::{BoxTest, Bvh, Node8, QNode8, Ray8, SahCost, ScalarBoxes, WideBvh, WideNode};
 use crate::geometry::{Aabb, Ray, TriangleHit, WatertightRay};
 use block::{Block, FILTERED, ID_MASK, LANES, SPHERE};
+use indexed::IndexedLeaves;
 
 pub use crate::bvh::Simd;
+pub use geometry::{Geometry, Located, TriangleMesh};
+pub use layout::{AccelLayout, LeafLayout, NodeLayout, INDEXED_FROM};
 
 // Every leaf of the build fits one block.
 const _: () = assert!(SahCost::BLOCKS.max_leaf == LANES);
@@ -69,18 +77,6 @@ pub fn accept_all(_: u32, _: &TriangleHit) -> bool {
     true
 }
 
-/// How the wide BVH's nodes store their child boxes. Both find the same hits (the
-/// quantized boxes contain the exact ones, and the primitive tests decide).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub enum NodeLayout {
-    /// Full f32 planes ([`Node8`], 256 bytes a node): the default, the faster one
-    /// measured (bench/README.md, "Compressed nodes").
-    #[default]
-    Full,
-    /// Child boxes in bytes against a per-node frame ([`QNode8`], 128 bytes a node).
-    Quantized,
-}
-
 #[derive(Clone, Debug)]
 enum Tree {
     Full(WideBvh<Node8>),
@@ -93,10 +89,25 @@ impl Default for Tree {
     }
 }
 
+/// The primitives of the leaves, in the layout [`LeafLayout`] names.
+#[derive(Clone, Debug)]
+enum Leaves {
+    /// One block a leaf; a wide node's leaf lane names its block.
+    Inline(Vec<Block>),
+    /// A wide node's leaf lane names its first record.
+    Indexed(IndexedLeaves),
+}
+
+impl Default for Leaves {
+    fn default() -> Self {
+        Leaves::Inline(Vec::new())
+    }
+}
+
 #[derive(Clone, Debug, Default)]
 pub struct Accel {
     tree: Tree,
-    blocks: Vec<Block>,
+    leaves: Leaves,
     simd: Simd,
     /// Whether every primitive is an unfiltered triangle: the AVX2 traversal then runs
     /// a copy whose block tests skip the check for spheres and filters.
@@ -116,76 +127,86 @@ impl Accel {
         Accel::build_layout(shapes, filtered, simd, NodeLayout::Full)
     }
 
-    /// [`Accel::build_for`] with the given node layout.
+    /// [`Accel::build_for`] with the given layout.
     pub fn build_layout(
         shapes: &[Shape],
         filtered: impl Fn(u32) -> bool,
         simd: Simd,
-        layout: NodeLayout,
+        layout: impl Into<AccelLayout>,
     ) -> Accel {
-        Accel::build_indexed(shapes.len(), |i| shapes[i as usize], filtered, simd, layout)
+        let layout = layout.into();
+        let shape = |i: u32| shapes[i as usize];
+        let flags = |i: u32| flags_of(&shape(i), filtered(i));
+        let (bvh, order) = Accel::tree(shapes.len(), |i| shape(i).bounds());
+        Accel::finish(bvh, &order, layout, shape, flags, simd, |order| {
+            IndexedLeaves::from_shapes(order, shape, flags)
+        })
     }
 
-    /// [`Accel::build_layout`] over `count` primitives that `shape(i)` gives, so that a
-    /// big scene need not hold an array of shapes beside its meshes while it builds.
-    pub fn build_indexed(
-        count: usize,
+    /// Builds over a scene's primitives by reference to its meshes' arrays (see
+    /// [`Geometry`]: hits report ids in its order), with the given kernels and layout.
+    pub fn build_geometry(geometry: &Geometry, simd: Simd, layout: AccelLayout) -> Accel {
+        let shape = |i: u32| geometry.shape(i);
+        let flags = |i: u32| flags_of(&shape(i), geometry.filtered(i));
+        let (bvh, order) = Accel::tree(geometry.len(), |i| shape(i).bounds());
+        Accel::finish(bvh, &order, layout, shape, flags, simd, |order| {
+            IndexedLeaves::from_geometry(geometry, order, flags)
+        })
+    }
+
+    /// The wide tree over `count` primitives whose boxes `bounds(i)` gives, and its leaf
+    /// order. Primitives with empty or non-finite boxes are left out.
+    fn tree(count: usize, bounds: impl Fn(u32) -> Aabb) -> (WideBvh<Node8>, Vec<u32>) {
+        assert!(
+            count < ID_MASK as usize,
+            "at most 2^30 primitives per scene"
+        );
+        let binary = Bvh::build_from(count, |i| bounds(i as u32), SahCost::BLOCKS);
+        // The binary nodes are gone (at the end of this scope) before the leaves take
+        // their memory.
+        let bvh = WideBvh::collapse(&binary);
+        (bvh, binary.prims)
+    }
+
+    /// The structure with leaves in `layout` over the tree's leaf `order`: inline blocks
+    /// of `shape(i)` and `flags(i)`, or the records `indexed(order)` makes.
+    fn finish(
+        mut bvh: WideBvh<Node8>,
+        order: &[u32],
+        layout: AccelLayout,
         shape: impl Fn(u32) -> Shape,
-        filtered: impl Fn(u32) -> bool,
+        flags: impl Fn(u32) -> u32,
         simd: Simd,
-        layout: NodeLayout,
+        indexed: impl FnOnce(&[u32]) -> IndexedLeaves,
     ) -> Accel {
         assert!(
             simd.is_supported(),
             "{simd:?} kernels on a CPU without them"
         );
-        assert!(
-            count < ID_MASK as usize,
-            "at most 2^30 primitives per scene"
-        );
-        let binary = Bvh::build_from(count, |i| shape(i as u32).bounds(), SahCost::BLOCKS);
-        let record = |i: u32| match shape(i) {
-            Shape::Triangle(v) => (v, i | if filtered(i) { FILTERED } else { 0 }),
-            Shape::Sphere { center, radius } => (
-                [center, Vec3::new(radius, 0.0, 0.0), Vec3::ZERO],
-                i | SPHERE,
-            ),
-        };
-        // The wide tree first, so that the binary nodes are gone before the blocks take
-        // their memory; then one block per wide leaf lane, in the wide nodes' order, its
-        // lane pointing at the block rather than the primitive range.
-        let mut bvh = WideBvh::collapse(&binary);
-        let prims = binary.prims;
-        drop(binary.nodes);
-        let leaves = bvh
-            .nodes
-            .iter()
-            .flat_map(|n| n.count)
-            .filter(|&c| c > 0)
-            .count();
-        let mut blocks = Vec::with_capacity(leaves);
-        let mut lanes = [([Vec3::ZERO; 3], 0u32); LANES];
-        for node in &mut bvh.nodes {
-            for lane in 0..node.child.len() {
-                let count = node.count[lane] as usize;
-                if count > 0 {
-                    let first = node.child[lane] as usize;
-                    for (slot, &i) in lanes.iter_mut().zip(&prims[first..first + count]) {
-                        *slot = record(i);
+        let leaves = match layout.leaves {
+            LeafLayout::Inline => Leaves::Inline(inline_blocks(&mut bvh, order, |i| {
+                let v = match shape(i) {
+                    Shape::Triangle(v) => v,
+                    Shape::Sphere { center, radius } => {
+                        [center, Vec3::new(radius, 0.0, 0.0), Vec3::ZERO]
                     }
-                    node.child[lane] = blocks.len() as u32;
-                    blocks.push(Block::new(&lanes[..count]));
-                }
-            }
-        }
-        let tree = match layout {
+                };
+                (v, i | flags(i))
+            })),
+            // The wide nodes' leaf lanes already name their first primitive in leaf order.
+            LeafLayout::Indexed => Leaves::Indexed(indexed(order)),
+        };
+        let plain = match &leaves {
+            Leaves::Inline(blocks) => blocks.iter().all(Block::is_plain),
+            Leaves::Indexed(x) => x.is_plain(),
+        };
+        let tree = match layout.nodes {
             NodeLayout::Full => Tree::Full(bvh),
             NodeLayout::Quantized => Tree::Quantized(bvh.quantize()),
         };
-        let plain = blocks.iter().all(Block::is_plain);
         Accel {
             tree,
-            blocks,
+            leaves,
             simd,
             plain,
         }
@@ -198,20 +219,31 @@ impl Accel {
         }
     }
 
-    pub fn layout(&self) -> NodeLayout {
-        match self.tree {
-            Tree::Full(_) => NodeLayout::Full,
-            Tree::Quantized(_) => NodeLayout::Quantized,
+    pub fn layout(&self) -> AccelLayout {
+        AccelLayout {
+            nodes: match self.tree {
+                Tree::Full(_) => NodeLayout::Full,
+                Tree::Quantized(_) => NodeLayout::Quantized,
+            },
+            leaves: match self.leaves {
+                Leaves::Inline(_) => LeafLayout::Inline,
+                Leaves::Indexed(_) => LeafLayout::Indexed,
+            },
         }
     }
 
-    /// Bytes of the wide BVH's nodes and of the primitive blocks.
+    /// Bytes of the wide BVH's nodes and of the leaves (blocks, or records and
+    /// vertices).
     pub fn memory(&self) -> (usize, usize) {
         let nodes = match &self.tree {
             Tree::Full(t) => size_of_val(&t.nodes[..]),
             Tree::Quantized(t) => size_of_val(&t.nodes[..]),
         };
-        (nodes, size_of_val(&self.blocks[..]))
+        let leaves = match &self.leaves {
+            Leaves::Inline(blocks) => size_of_val(&blocks[..]),
+            Leaves::Indexed(x) => x.memory(),
+        };
+        (nodes, leaves)
     }
 
     /// The kernels this structure traces with.
@@ -307,57 +339,29 @@ impl Accel {
         filter: &impl Fn(u32, &TriangleHit) -> bool,
     ) -> Option<Hit> {
         match &self.tree {
-            Tree::Full(t) => self.intersect_tree::<K, LEAF, PLAIN, _>(t, ray, t_max, filter),
-            Tree::Quantized(t) => self.intersect_tree::<K, LEAF, PLAIN, _>(t, ray, t_max, filter),
+            Tree::Full(t) => self.intersect_leaves::<K, LEAF, PLAIN, _>(t, ray, t_max, filter),
+            Tree::Quantized(t) => self.intersect_leaves::<K, LEAF, PLAIN, _>(t, ray, t_max, filter),
         }
     }
 
     /// # Safety
     /// The CPU must support `K` and `LEAF`.
     #[inline(always)]
-    unsafe fn intersect_tree<K: BoxTest, const LEAF: u8, const PLAIN: bool, N: WideNode>(
+    unsafe fn intersect_leaves<K: BoxTest, const LEAF: u8, const PLAIN: bool, N: WideNode>(
         &self,
         tree: &WideBvh<N>,
         ray: &Ray,
         t_max: f32,
         filter: &impl Fn(u32, &TriangleHit) -> bool,
     ) -> Option<Hit> {
-        let r8 = Ray8::new(ray);
-        let wray = WatertightRay::from_recip(ray, r8.inv_d);
-        let mut best: Option<Hit> = None;
-        tree.intersect::<K>(
-            &r8,
-            t_max,
-            #[inline(always)]
-            |block, count, t_max| {
-                let block = &self.blocks[block as usize];
-                // Opaque to the optimizer, so that the block test's broadcasts of the
-                // watertight ray are made where a block is tested: otherwise they are
-                // hoisted into the query's setup and spilled, paid by every query though
-                // a shadow ray tests 0.64 blocks on average (callgrind, Cornell render
-                // 128², 1 spp: closest 559.3 -> 545.4 instructions a query, shadow
-                // 366.1 -> 347.1). A hint: it changes no result.
-                let wray = std::hint::black_box(&wray);
-                match block.intersect::<LEAF, false, PLAIN>(ray, wray, count, t_max, filter) {
-                    Some(h) => {
-                        best = Some(Hit {
-                            prim: h.id,
-                            t: h.hit.t,
-                            b1: h.hit.b1,
-                            b2: h.hit.b2,
-                        });
-                        h.hit.t
-                    }
-                    None => t_max,
-                }
-            },
-            #[inline(always)]
-            |block| {
-                let at = self.blocks.as_ptr().wrapping_add(block as usize);
-                crate::bvh::prefetch(at as *const u8, size_of::<Block>() / 64)
-            },
-        );
-        best
+        match &self.leaves {
+            Leaves::Inline(b) => {
+                intersect_tree::<K, LEAF, PLAIN, _, _>(tree, &b[..], ray, t_max, filter)
+            }
+            Leaves::Indexed(x) => {
+                intersect_tree::<K, LEAF, PLAIN, _, _>(tree, x, ray, t_max, filter)
+            }
+        }
     }
 
     /// # Safety
@@ -370,34 +374,188 @@ impl Accel {
         filter: &impl Fn(u32, &TriangleHit) -> bool,
     ) -> bool {
         match &self.tree {
-            Tree::Full(t) => self.occluded_tree::<K, LEAF, PLAIN, _>(t, ray, t_max, filter),
-            Tree::Quantized(t) => self.occluded_tree::<K, LEAF, PLAIN, _>(t, ray, t_max, filter),
+            Tree::Full(t) => self.occluded_leaves::<K, LEAF, PLAIN, _>(t, ray, t_max, filter),
+            Tree::Quantized(t) => self.occluded_leaves::<K, LEAF, PLAIN, _>(t, ray, t_max, filter),
         }
     }
 
     /// # Safety
     /// The CPU must support `K` and `LEAF`.
     #[inline(always)]
-    unsafe fn occluded_tree<K: BoxTest, const LEAF: u8, const PLAIN: bool, N: WideNode>(
+    unsafe fn occluded_leaves<K: BoxTest, const LEAF: u8, const PLAIN: bool, N: WideNode>(
         &self,
         tree: &WideBvh<N>,
         ray: &Ray,
         t_max: f32,
         filter: &impl Fn(u32, &TriangleHit) -> bool,
     ) -> bool {
-        let r8 = Ray8::new(ray);
-        let wray = WatertightRay::from_recip(ray, r8.inv_d);
-        tree.occluded::<K>(
-            &r8,
-            t_max,
-            #[inline(always)]
-            |block, count, t_max| {
-                // As in `intersect_tree`: the broadcasts where a block is tested.
-                let wray = std::hint::black_box(&wray);
-                self.blocks[block as usize]
+        match &self.leaves {
+            Leaves::Inline(b) => {
+                occluded_tree::<K, LEAF, PLAIN, _, _>(tree, &b[..], ray, t_max, filter)
+            }
+            Leaves::Indexed(x) => {
+                occluded_tree::<K, LEAF, PLAIN, _, _>(tree, x, ray, t_max, filter)
+            }
+        }
+    }
+}
+
+/// # Safety
+/// The CPU must support `K` and `LEAF`.
+#[inline(always)]
+unsafe fn intersect_tree<
+    K: BoxTest,
+    const LEAF: u8,
+    const PLAIN: bool,
+    N: WideNode,
+    L: LeafBlocks + ?Sized,
+>(
+    tree: &WideBvh<N>,
+    leaves: &L,
+    ray: &Ray,
+    t_max: f32,
+    filter: &impl Fn(u32, &TriangleHit) -> bool,
+) -> Option<Hit> {
+    let r8 = Ray8::new(ray);
+    let wray = WatertightRay::from_recip(ray, r8.inv_d);
+    let mut best: Option<Hit> = None;
+    tree.intersect::<K>(
+        &r8,
+        t_max,
+        #[inline(always)]
+        |leaf, count, t_max| {
+            // Opaque to the optimizer, so that the block test's broadcasts of the
+            // watertight ray are made where a block is tested: otherwise they are
+            // hoisted into the query's setup and spilled, paid by every query though
+            // a shadow ray tests 0.64 blocks on average (callgrind, Cornell render
+            // 128², 1 spp: closest 559.3 -> 545.4 instructions a query, shadow
+            // 366.1 -> 347.1). A hint: it changes no result.
+            let wray = std::hint::black_box(&wray);
+            let hit = leaves.with_block(leaf, count, |block| {
+                block.intersect::<LEAF, false, PLAIN>(ray, wray, count, t_max, filter)
+            });
+            match hit {
+                Some(h) => {
+                    best = Some(Hit {
+                        prim: h.id,
+                        t: h.hit.t,
+                        b1: h.hit.b1,
+                        b2: h.hit.b2,
+                    });
+                    h.hit.t
+                }
+                None => t_max,
+            }
+        },
+        #[inline(always)]
+        |leaf| leaves.prefetch(leaf),
+    );
+    best
+}
+
+/// # Safety
+/// The CPU must support `K` and `LEAF`.
+#[inline(always)]
+unsafe fn occluded_tree<
+    K: BoxTest,
+    const LEAF: u8,
+    const PLAIN: bool,
+    N: WideNode,
+    L: LeafBlocks + ?Sized,
+>(
+    tree: &WideBvh<N>,
+    leaves: &L,
+    ray: &Ray,
+    t_max: f32,
+    filter: &impl Fn(u32, &TriangleHit) -> bool,
+) -> bool {
+    let r8 = Ray8::new(ray);
+    let wray = WatertightRay::from_recip(ray, r8.inv_d);
+    tree.occluded::<K>(
+        &r8,
+        t_max,
+        #[inline(always)]
+        |leaf, count, t_max| {
+            // As in `intersect_tree`: the broadcasts where a block is tested.
+            let wray = std::hint::black_box(&wray);
+            leaves.with_block(leaf, count, |block| {
+                block
                     .intersect::<LEAF, true, PLAIN>(ray, wray, count, t_max, filter)
                     .is_some()
-            },
-        )
+            })
+        },
+    )
+}
+
+/// Where the traversal finds a leaf's block: the inline blocks hold it, an indexed leaf
+/// gathers it.
+trait LeafBlocks {
+    /// `test` on the block of leaf lane `leaf` (`count` primitives).
+    fn with_block<R>(&self, leaf: u32, count: u32, test: impl FnOnce(&Block) -> R) -> R;
+    /// Asks for leaf `leaf`'s memory to be loaded (see [`crate::bvh::prefetch`]).
+    fn prefetch(&self, leaf: u32);
+}
+
+impl LeafBlocks for [Block] {
+    #[inline(always)]
+    fn with_block<R>(&self, leaf: u32, _: u32, test: impl FnOnce(&Block) -> R) -> R {
+        test(&self[leaf as usize])
     }
+
+    #[inline(always)]
+    fn prefetch(&self, leaf: u32) {
+        let at = self.as_ptr().wrapping_add(leaf as usize);
+        crate::bvh::prefetch(at as *const u8, size_of::<Block>() / 64)
+    }
+}
+
+impl LeafBlocks for IndexedLeaves {
+    #[inline(always)]
+    fn with_block<R>(&self, leaf: u32, count: u32, test: impl FnOnce(&Block) -> R) -> R {
+        test(&self.block(leaf, count))
+    }
+
+    #[inline(always)]
+    fn prefetch(&self, leaf: u32) {
+        // The records (the vertices they name are known only once these are loaded).
+        crate::bvh::prefetch(self.record_at(leaf), 1)
+    }
+}
+
+/// The flag bits of a primitive's id.
+fn flags_of(shape: &Shape, filtered: bool) -> u32 {
+    match shape {
+        Shape::Sphere { .. } => SPHERE,
+        Shape::Triangle(_) if filtered => FILTERED,
+        Shape::Triangle(_) => 0,
+    }
+}
+
+/// One block a leaf lane of `bvh`, in its nodes' order, each lane then naming its block
+/// rather than its first primitive of `order`; `record(i)` gives primitive `i`'s block
+/// lane (vertices, id with flags).
+fn inline_blocks(
+    bvh: &mut WideBvh<Node8>,
+    order: &[u32],
+    record: impl Fn(u32) -> ([Vec3; 3], u32),
+) -> Vec<Block> {
+    let leaves = bvh
+        .nodes
+        .iter()
+        .flat_map(|n| n.count)
+        .filter(|&c| c > 0)
+        .count();
+    let mut blocks = Vec::with_capacity(leaves);
+    for node in &mut bvh.nodes {
+        for lane in 0..node.child.len() {
+            let count = node.count[lane] as usize;
+            if count > 0 {
+                let first = node.child[lane] as usize;
+                let prims = &order[first..first + count];
+                node.child[lane] = blocks.len() as u32;
+                blocks.push(Block::gather(count, |k| record(prims[k])));
+            }
+        }
+    }
+    blocks
 }

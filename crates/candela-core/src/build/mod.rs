@@ -19,7 +19,9 @@ use std::sync::Arc;
 
 use glam::Vec3;
 
-use crate::accel::{Accel, NodeLayout, Shape, Simd};
+use crate::accel::{
+    Accel, AccelLayout, Geometry, LeafLayout, NodeLayout, Shape, Simd, TriangleMesh,
+};
 use crate::desc::{GeometryDesc, MeshDesc, RenderSettings, SceneDesc, Span};
 use crate::geometry::Aabb;
 use crate::instance::{Instance, Instances, Transform};
@@ -212,8 +214,8 @@ fn build_taking(desc: &SceneDesc, mut taken: Vec<Option<MeshDesc>>) -> Result<Sc
         }));
     }
     prims.extend((0..spheres.len() as u32).map(Prim::Sphere));
-    // Each primitive's shape as the accelerator needs it, made when asked rather than
-    // held in an array beside the meshes.
+    // Each primitive's shape, made when asked rather than held in an array beside the
+    // meshes.
     let shape = |i: u32| match prims[i as usize] {
         Prim::Triangle { mesh, tri } => Shape::Triangle(meshes[mesh as usize].vertices(tri)),
         Prim::Sphere(s) => Shape::Sphere {
@@ -221,18 +223,25 @@ fn build_taking(desc: &SceneDesc, mut taken: Vec<Option<MeshDesc>>) -> Result<Sc
             radius: spheres[s as usize].radius,
         },
     };
-    // Only triangles of alpha-masked meshes pay for the filter.
-    let accel = Accel::build_indexed(
-        prims.len(),
-        shape,
-        |i| match prims[i as usize] {
-            Prim::Triangle { mesh, .. } => meshes[mesh as usize].alpha.is_some(),
-            Prim::Sphere(_) => false,
-        },
-        Simd::best(),
-        NodeLayout::Full,
+    // The accelerator reads the meshes' own arrays; only triangles of alpha-masked meshes
+    // pay for the filter.
+    let geometry = Geometry::new(
+        meshes
+            .iter()
+            .map(|m| TriangleMesh {
+                positions: &m.positions,
+                indices: &m.indices,
+                filtered: m.alpha.is_some(),
+            })
+            .collect(),
+        spheres.iter().map(|s| (s.center, s.radius)).collect(),
     );
-    let instances = Instances::new(object_meshes, instances);
+    let layout = AccelLayout {
+        nodes: NodeLayout::Full,
+        leaves: LeafLayout::choose(r.accel, geometry.len()),
+    };
+    let accel = Accel::build_geometry(&geometry, Simd::best(), layout);
+    let instances = Instances::new(object_meshes, instances, r.accel);
     let bounds = (0..prims.len() as u32)
         .map(|i| shape(i).bounds())
         .chain((!instances.is_empty()).then(|| instances.bounds()))

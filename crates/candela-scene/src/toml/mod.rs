@@ -20,8 +20,8 @@ mod values;
 use std::path::Path;
 
 use candela_core::desc::{
-    BsdfDesc, EmissionProfileDesc, FilterSampling, LampSampling, LightSamplerKind, MaterialDesc,
-    MisMode, RenderSettings, SamplerKind, SceneDesc, ShapeMediaDesc,
+    AccelStorage, BsdfDesc, EmissionProfileDesc, FilterSampling, LampSampling, LightSamplerKind,
+    MaterialDesc, MisMode, RenderSettings, SamplerKind, SceneDesc, ShapeMediaDesc,
 };
 use serde::de::DeserializeOwned;
 use serde::Deserialize;
@@ -215,6 +215,7 @@ struct RenderSection {
     sampler: Option<SamplerKind>,
     aov: Option<Vec<candela_core::aov::AovKind>>,
     filter_sampling: Option<FilterSampling>,
+    accel: Option<AccelStorage>,
 }
 
 fn parse_render(src: &Source, value: Item) -> Result<RenderSettings, LoadError> {
@@ -238,6 +239,7 @@ fn parse_render(src: &Source, value: Item) -> Result<RenderSettings, LoadError> 
     out.sampler = r.sampler.unwrap_or(out.sampler);
     out.aovs = r.aov.into_iter().flatten().collect();
     out.filter_sampling = r.filter_sampling.unwrap_or(out.filter_sampling);
+    out.accel = r.accel.unwrap_or(out.accel);
     Ok(out)
 }
 
