@@ -14,11 +14,13 @@ use glam::{Affine2, Mat3, Mat4, Vec2, Vec3, Vec4};
 use crate::options::AovSet;
 
 mod builders;
+mod conductors;
 mod media;
 
 pub use crate::options::{
     FilterSampling, Isa, LampSampling, LightSamplerKind, MisMode, SamplerKind,
 };
+pub use conductors::{conductor, metal_preset, CONDUCTORS, METAL_PRESETS};
 pub use media::*;
 
 /// Where an item of a description came from: `file:line:col` (1-based). Items made in code
@@ -180,8 +182,8 @@ pub enum BsdfDesc {
     /// No surface at all: rays pass straight through. Only a medium's boundary (Mitsuba's
     /// `null` BSDF).
     Null,
-    /// A metal with complex index η + ik per channel (see
-    /// [`crate::bsdf::metal_preset`] for named metals); α along the tangent and bitangent.
+    /// A metal with complex index η + ik per channel (see [`CONDUCTORS`] for named
+    /// metals); α along the tangent and bitangent.
     Conductor {
         eta: Vec3,
         k: Vec3,
