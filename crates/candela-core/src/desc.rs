@@ -5,6 +5,14 @@
 //! code. Every item remembers where it came from ([`Span`]) so that build errors can point
 //! at the file, line and column that caused them. Units: radiance in W·sr⁻¹·m⁻², linear
 //! Rec.709 primaries; lengths in scene units; angles in degrees where a field says so.
+//!
+//! The description is the bottom layer: loaders produce it, [`crate::build`] reads it,
+//! and it imports nothing from the renderer. Its only imports inside the crate are the
+//! option enums it shares with the renderer ([`crate::options`]) and the sampling math
+//! ([`crate::sampling`], itself free of crate imports) that a [`photometry`] table, the
+//! canonical form loaders make of a measured profile, samples with
+//! (`tests/layering.rs` checks this). Besides the records, it holds the named conductors
+//! every loader's presets read ([`CONDUCTORS`]) and builders for writing a scene in code.
 
 use std::fmt;
 use std::sync::Arc;
@@ -14,11 +22,14 @@ use glam::{Affine2, Mat3, Mat4, Vec2, Vec3, Vec4};
 use crate::options::AovSet;
 
 mod builders;
+mod conductors;
 mod media;
+pub mod photometry;
 
 pub use crate::options::{
     AccelStorage, FilterSampling, Isa, LampSampling, LightSamplerKind, MisMode, SamplerKind,
 };
+pub use conductors::{conductor, metal_preset, CONDUCTORS, METAL_PRESETS};
 pub use media::*;
 
 /// Where an item of a description came from: `file:line:col` (1-based). Items made in code
@@ -180,8 +191,8 @@ pub enum BsdfDesc {
     /// No surface at all: rays pass straight through. Only a medium's boundary (Mitsuba's
     /// `null` BSDF).
     Null,
-    /// A metal with complex index η + ik per channel (see
-    /// [`crate::bsdf::metal_preset`] for named metals); α along the tangent and bitangent.
+    /// A metal with complex index η + ik per channel (see [`CONDUCTORS`] for named
+    /// metals); α along the tangent and bitangent.
     Conductor {
         eta: Vec3,
         k: Vec3,
@@ -453,7 +464,7 @@ pub enum LightAmountDesc {
 /// along `nadir`, its C0 plane towards `c0` (made orthogonal to `nadir`).
 #[derive(Clone, Debug)]
 pub struct ProfileDesc {
-    pub table: Arc<crate::photometry::GoniometricTable>,
+    pub table: Arc<photometry::GoniometricTable>,
     pub nadir: Vec3,
     pub c0: Vec3,
     pub span: Span,
@@ -539,7 +550,7 @@ pub enum ProjectionDesc {
 #[derive(Clone, Debug)]
 pub struct EmissionProfileDesc {
     pub shape: usize,
-    pub table: Arc<crate::photometry::GoniometricTable>,
+    pub table: Arc<photometry::GoniometricTable>,
     pub span: Span,
 }
 

@@ -40,11 +40,11 @@ pub mod material;
 pub mod math;
 pub mod medium;
 pub mod options;
-pub mod photometry;
 pub mod sampler;
 pub mod sampling;
 pub mod scene;
 pub mod splat;
 pub mod texture;
 
+pub use desc::photometry;
 pub use scene::Scene;

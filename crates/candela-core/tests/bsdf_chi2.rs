@@ -122,7 +122,7 @@ const GGX: Distribution = ("GGX", Microfacet::ggx);
 const BECKMANN: Distribution = ("Beckmann", Microfacet::beckmann);
 
 fn conductor(distrib: Microfacet) -> Lobe {
-    let (eta, k) = candela_core::bsdf::metal_preset("Au").unwrap();
+    let (eta, k) = candela_core::desc::metal_preset("Au").unwrap();
     Lobe::Conductor(Conductor {
         distrib,
         fresnel: ConductorFresnel::Complex { eta, k },

@@ -155,7 +155,7 @@ fn no_bsdf_returns_more_than_it_receives() {
     };
     let mut lobes = vec![
         ("conductor Ag α=0.2", {
-            let (eta, k) = candela_core::bsdf::metal_preset("Ag").unwrap();
+            let (eta, k) = candela_core::desc::metal_preset("Ag").unwrap();
             Lobe::Conductor(Conductor {
                 distrib: Microfacet::ggx(0.2, 0.05),
                 fresnel: ConductorFresnel::Complex { eta, k },
@@ -172,7 +172,7 @@ fn no_bsdf_returns_more_than_it_receives() {
         ),
     ];
     lobes.push(("Beckmann conductor Ag α=(0.2,0.05)", {
-        let (eta, k) = candela_core::bsdf::metal_preset("Ag").unwrap();
+        let (eta, k) = candela_core::desc::metal_preset("Ag").unwrap();
         Lobe::Conductor(Conductor {
             distrib: Microfacet::beckmann(0.2, 0.05),
             fresnel: ConductorFresnel::Complex { eta, k },

@@ -14,13 +14,11 @@
 //! this file with Šidák's correction. A pair of sample indices of one pixel is *not*
 //! uniform on the square (the pair is stratified), and the same test rejects it.
 
-mod sampler_checks;
-
 use candela_core::sampler::{CmjSampler, IndependentSampler, Sampler};
-use glam::{UVec2, Vec2};
-use sampler_checks::{
+use candela_test_support::samplers::{
     chi2_over_pixels, draw, one_per_cell, points, strata, two_requests_are_independent, Request,
 };
+use glam::{UVec2, Vec2};
 
 const REQUESTS: [Request; 6] = [
     Request::TwoD { skip: 0 },

@@ -18,8 +18,7 @@ use candela_core::integrator::render;
 use candela_core::math::luminance;
 use glam::{Mat4, Vec3};
 
-mod tile_welch;
-use tile_welch::push_tile_means;
+use candela_test_support::tiles;
 
 const RES: u32 = 64;
 const TILE: u32 = 8;
@@ -103,20 +102,16 @@ fn tile_means(
     sampling: FilterSampling,
     light_scale: f32,
 ) -> Vec<Vec<f64>> {
-    let tiles = (RES / TILE) as usize;
-    let mut out = vec![Vec::new(); tiles * tiles];
-    for k in 0..RENDERS {
+    tiles::tile_means(RENDERS, RES, TILE, |k| {
         let mut desc = scene(filter, sampling, light_scale);
         desc.render.seed = 100 + k;
-        let img = render_film(&desc).resolve();
-        push_tile_means(&mut out, &img, RES, TILE);
-    }
-    out
+        render_film(&desc).resolve()
+    })
 }
 
 /// Tiles whose Welch test rejects equality at [`ALPHA`].
 fn failing_tiles(a: &[Vec<f64>], b: &[Vec<f64>]) -> Vec<(usize, f64)> {
-    tile_welch::failing_tiles(a, b, ALPHA)
+    tiles::failing_tiles(a, b, ALPHA)
 }
 
 #[test]

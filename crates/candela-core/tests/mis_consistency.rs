@@ -20,8 +20,7 @@ use candela_core::desc::*;
 use candela_core::integrator::render;
 use glam::Vec3;
 
-mod tile_welch;
-use tile_welch::push_tile_means;
+use candela_test_support::tiles;
 
 const RES: u32 = 64;
 const TILE: u32 = 8;
@@ -107,23 +106,19 @@ fn tile_means(
     light_scale: f32,
     seed_base: u64,
 ) -> Vec<Vec<f64>> {
-    let tiles = (RES / TILE) as usize;
-    let mut out = vec![Vec::new(); tiles * tiles];
-    for k in 0..RENDERS {
+    tiles::tile_means(RENDERS, RES, TILE, |k| {
         let mut desc = cornell(mis, light_scale);
         desc.render.seed = seed_base + k;
         desc.render.sampler = sampler;
         let scene = build(&desc).expect("Cornell box builds");
         let film = render(&scene, 0..SPP, &AtomicBool::new(false), &|_| {}).film;
-        let img = film.resolve();
-        push_tile_means(&mut out, &img, RES, TILE);
-    }
-    out
+        film.resolve()
+    })
 }
 
 /// Tiles whose Welch test rejects equality at [`ALPHA`].
 fn failing_tiles(a: &[Vec<f64>], b: &[Vec<f64>]) -> Vec<(usize, f64)> {
-    tile_welch::failing_tiles(a, b, ALPHA)
+    tiles::failing_tiles(a, b, ALPHA)
 }
 
 #[test]

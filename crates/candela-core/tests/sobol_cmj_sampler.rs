@@ -13,8 +13,6 @@
 //! this file with Šidák's correction. A pair of sample indices of one pixel is *not*
 //! uniform on the square (the pair is stratified), and the same test rejects it.
 
-mod sampler_checks;
-
 use std::sync::atomic::AtomicBool;
 use std::sync::Arc;
 
@@ -24,8 +22,8 @@ use candela_core::integrator::render;
 use candela_core::sampler::{
     first_direction_dimension, IndependentSampler, Sampler, SobolCmjSampler, SobolSampler,
 };
+use candela_test_support::samplers::{chi2_over_pixels, one_per_cell, strata, Request};
 use glam::{UVec2, Vec2, Vec3};
-use sampler_checks::{chi2_over_pixels, one_per_cell, strata, Request};
 
 /// The first bounce's BSDF direction of a pixel sample, reached through the requests the
 /// integrator takes before it (pixel, lens, light pick, light point, deferred lobe).

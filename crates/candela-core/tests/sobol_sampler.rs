@@ -13,11 +13,11 @@
 //! this file with Šidák's correction. A pair of consecutive sample indices of one pixel is
 //! *not* uniform on the square (the pair is stratified), and the same test rejects it.
 
-mod sampler_checks;
-
 use candela_core::sampler::{IndependentSampler, SobolSampler};
+use candela_test_support::samplers::{
+    chi2_over_pixels, draw, points, two_requests_are_independent, Request,
+};
 use glam::{UVec2, Vec2};
-use sampler_checks::{chi2_over_pixels, draw, points, two_requests_are_independent, Request};
 
 /// Whether the points are a (0, k, 2)-net (2D) or a one-per-stratum set (1D), k = log2 n.
 fn is_stratified(points: &[Vec2], two_d: bool) -> bool {

@@ -3,8 +3,6 @@
 //! alike; a BLEND quad of α = a stops a fraction a of rays (binomial z test), so a
 //! render through it sees the background with transmittance 1 − a.
 
-mod gltf_common;
-
 use std::path::Path;
 use std::sync::atomic::AtomicBool;
 
@@ -14,8 +12,8 @@ use candela_core::sampler::Pcg32;
 use candela_core::Scene;
 use candela_scene::gltf::parse_gltf;
 use candela_scene::LoadOptions;
+use candela_test_support::gltf::{png, Glb};
 use glam::Vec3;
-use gltf_common::{png, Glb};
 use serde_json::json;
 
 /// A quad [-1, 1]² at z = 0 with the given material JSON (texture 0, if the material

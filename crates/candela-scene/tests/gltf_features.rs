@@ -1,8 +1,6 @@
-//! glTF import on files the tests make (tests/gltf_common writes GLB bytes): every
+//! glTF import on files the tests make (candela_test_support::gltf writes GLB bytes): every
 //! feature round-trips into the expected description, photometric units come out at
 //! 683 lm/W in a render, and broken files give located errors, not panics.
-
-mod gltf_common;
 
 use std::path::Path;
 use std::sync::atomic::AtomicBool;
@@ -15,8 +13,8 @@ use candela_core::desc::{
 };
 use candela_scene::gltf::parse_gltf;
 use candela_scene::{LoadOptions, LoadedScene};
+use candela_test_support::gltf::{png, Glb};
 use glam::{Mat4, Quat, Vec2, Vec3};
-use gltf_common::{png, Glb};
 use serde_json::json;
 
 /// cos 45°, for quaternions of quarter turns.

@@ -1,14 +1,12 @@
 //! `[[include]]` of a glTF file in a TOML scene: the documented example parses, shapes
 //! and lights land where the include's transform puts them, materials do not clash.
 
-mod gltf_common;
-
 use std::fs;
 
 use candela_core::desc::{GeometryDesc, LightKindDesc};
 use candela_scene::{load_scene_with, LoadOptions};
+use candela_test_support::gltf::Glb;
 use glam::{Mat4, Vec3};
-use gltf_common::Glb;
 use serde_json::json;
 
 /// A GLB with one quad and a point light 2 units above it.

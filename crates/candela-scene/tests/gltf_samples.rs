@@ -3,8 +3,6 @@
 //! counts per placed primitive, POSITION bounds, material factors, lights), and each
 //! model must render without a non-finite sample.
 
-mod gltf_common;
-
 use std::path::{Path, PathBuf};
 use std::sync::atomic::AtomicBool;
 
@@ -143,7 +141,7 @@ fn close(a: Vec3, b: Vec3, what: &str) {
 }
 
 fn check_model(path: &Path) -> SceneDesc {
-    let json = gltf_common::read_json(&std::fs::read(path).unwrap());
+    let json = candela_test_support::gltf::read_json(&std::fs::read(path).unwrap());
     let loaded = load_scene_with(path, &LoadOptions::default()).unwrap();
     let desc = loaded.desc;
     let placed = placed(&json);

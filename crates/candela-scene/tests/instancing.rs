@@ -3,8 +3,6 @@
 //! several shapes), TOML `[[shape]]`s naming one file and a mesh's `instances` list. Bad
 //! references are located errors.
 
-mod gltf_common;
-
 use std::fs;
 use std::path::Path;
 use std::sync::Arc;
@@ -13,22 +11,20 @@ use candela_core::desc::{GeometryDesc, MeshDesc, SceneDesc};
 use candela_core::geometry::Ray;
 use candela_scene::gltf::parse_gltf;
 use candela_scene::{load_scene, LoadOptions};
+use candela_test_support::files;
+use candela_test_support::gltf::Glb;
 use glam::{Mat4, Vec3};
-use gltf_common::Glb;
 use serde_json::json;
 
 /// Two triangles: the square [0,1]² at z = 0 facing +z.
 const SQUARE_OBJ: &str =
     "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nvn 0 0 1\nf 1//1 2//1 3//1\nf 1//1 3//1 4//1\n";
 
-/// Writes `files` into a fresh folder and loads the first.
+/// Writes `files` (name, text) into a fresh folder and loads the first.
 fn load_files(files: &[(&str, &str)]) -> (tempfile::TempDir, Result<SceneDesc, String>) {
-    let dir = tempfile::tempdir().unwrap();
-    for (name, text) in files {
-        fs::write(dir.path().join(name), text).unwrap();
-    }
-    let r = load_scene(&dir.path().join(files[0].0)).map_err(|e| e.to_string());
-    (dir, r)
+    let files: Vec<(&str, &[u8])> = files.iter().map(|(n, t)| (*n, t.as_bytes())).collect();
+    let (dir, r) = files::load_files(&files, &LoadOptions::default());
+    (dir, r.map(|l| l.desc).map_err(|e| e.to_string()))
 }
 
 fn load(files: &[(&str, &str)]) -> SceneDesc {
@@ -38,8 +34,7 @@ fn load(files: &[(&str, &str)]) -> SceneDesc {
 /// The error, with the temporary folder taken off the file name.
 fn load_err(files: &[(&str, &str)]) -> String {
     let (dir, r) = load_files(files);
-    let e = r.expect_err("should fail");
-    e.replace(&format!("{}/", dir.path().display()), "")
+    files::without_dir(dir.path(), &r.expect_err("should fail"))
 }
 
 fn mesh(desc: &SceneDesc, i: usize) -> Arc<MeshDesc> {

@@ -3,19 +3,14 @@
 //! PLY's vertex colours, and the automatic camera and sky of a model without its own.
 
 use candela_core::desc::{BsdfDesc, GeometryDesc, SceneDesc, TextureDesc};
-use candela_scene::{load_scene_with, LoadOptions, LoadedScene};
+use candela_scene::{LoadOptions, LoadedScene};
+use candela_test_support::files::load_files;
 use glam::Vec3;
 
 /// Writes `files` into a fresh folder and loads the first as a scene.
 fn load(files: &[(&str, &[u8])]) -> Result<LoadedScene, String> {
-    let dir = tempfile::tempdir().unwrap();
-    for (name, bytes) in files {
-        let path = dir.path().join(name);
-        std::fs::create_dir_all(path.parent().unwrap()).unwrap();
-        std::fs::write(path, bytes).unwrap();
-    }
-    load_scene_with(&dir.path().join(files[0].0), &LoadOptions::default())
-        .map_err(|e| e.to_string())
+    let (_dir, r) = load_files(files, &LoadOptions::default());
+    r.map_err(|e| e.to_string())
 }
 
 fn albedo<'a>(desc: &'a SceneDesc, material: &str) -> &'a TextureDesc {

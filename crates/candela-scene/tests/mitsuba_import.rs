@@ -6,60 +6,18 @@
 use std::path::Path;
 
 use candela_core::camera::Camera;
-use candela_core::desc::{
-    BsdfDesc, GeometryDesc, LightKindDesc, SamplerKind, SceneDesc, TextureDesc,
-};
+use candela_core::desc::{BsdfDesc, GeometryDesc, LightKindDesc, SamplerKind, TextureDesc};
 use candela_core::geometry::Ray;
-use candela_scene::{load_scene_with, LoadError, LoadOptions, LoadedScene};
+use candela_scene::{load_scene_with, LoadOptions};
+use candela_test_support::assert_close;
+use candela_test_support::files::{load_files, options};
+use candela_test_support::mitsuba::{load, load_err, scene};
 use glam::{Vec2, Vec3};
-
-/// Writes `files` (name, text) into a fresh folder and loads the first.
-fn load_files(
-    files: &[(&str, &str)],
-    defines: &[(&str, &str)],
-    lenient: bool,
-) -> (tempfile::TempDir, Result<LoadedScene, LoadError>) {
-    let dir = tempfile::tempdir().unwrap();
-    for (name, text) in files {
-        std::fs::write(dir.path().join(name), text).unwrap();
-    }
-    let options = LoadOptions {
-        defines: defines
-            .iter()
-            .map(|(k, v)| (k.to_string(), v.to_string()))
-            .collect(),
-        lenient,
-        ..LoadOptions::default()
-    };
-    let r = load_scene_with(&dir.path().join(files[0].0), &options);
-    (dir, r)
-}
-
-fn load(xml: &str) -> SceneDesc {
-    let (_dir, r) = load_files(&[("scene.xml", xml)], &[], false);
-    r.unwrap_or_else(|e| panic!("{e}")).desc
-}
-
-fn load_err(xml: &str) -> String {
-    let (_dir, r) = load_files(&[("scene.xml", xml)], &[], false);
-    let e = r.expect_err("should fail").to_string();
-    // Every error names the file with line and column.
-    assert!(e.contains("scene.xml:"), "{e}");
-    e
-}
-
-fn scene(body: &str) -> String {
-    format!("<scene version=\"3.0.0\">\n{body}\n</scene>")
-}
 
 fn bbox(points: impl Iterator<Item = Vec3>) -> (Vec3, Vec3) {
     points.fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), p| {
         (lo.min(p), hi.max(p))
     })
-}
-
-fn assert_close(a: Vec3, b: Vec3, tol: f32) {
-    assert!((a - b).abs().max_element() < tol, "{a} vs {b}");
 }
 
 #[test]
@@ -86,7 +44,7 @@ fn transformed_shapes_land_where_mitsuba_puts_them() {
            <shape type="disk" id="d"><transform name="to_world">
              <lookat origin="1,1,1" target="2,1,1" up="0,1,0"/></transform></shape>"#,
     );
-    let desc = load(&xml);
+    let desc = load(&xml).desc;
     let mitsuba = [
         (
             Vec3::new(-0.530931, -4.0046, 1.75),
@@ -175,7 +133,7 @@ fn film_rays(kind: &str, props: &str, transform: &str) -> Vec<Ray> {
              <film type="hdrfilm"><integer name="width" value="200"/><integer name="height" value="100"/></film>
            </sensor>"#
     ));
-    let cam = Camera::new(&load(&xml).camera, 200, 100);
+    let cam = Camera::new(&load(&xml).desc.camera, 200, 100);
     [
         Vec2::new(200.0, 50.0),
         Vec2::new(100.0, 0.0),
@@ -256,7 +214,8 @@ fn lookat_without_up_rolls_the_frame_as_mitsuba_does() {
     let desc = load(&scene(
         r#"<shape type="rectangle"><transform name="to_world">
              <lookat origin="1,2,3" target="1,-1,3"/></transform></shape>"#,
-    ));
+    ))
+    .desc;
     let m = desc.shapes[0].transform;
     let (lo, hi) = bbox(
         candela_core::build::rectangle()
@@ -286,10 +245,13 @@ fn defaults_are_replaced_by_defines_and_unknown_parameters_are_errors() {
              <film type="hdrfilm"><integer name="width" value="$res"/><integer name="height" value="$res"/></film>
            </sensor>"#,
     );
-    let (_d, r) = load_files(&[("scene.xml", &xml)], &[], false);
+    let (_d, r) = load_files(&[("scene.xml", xml.as_bytes())], &options(&[], false));
     let r = r.unwrap().desc.render;
     assert_eq!((r.spp, r.width, r.height), (16, 32, 32));
-    let (_d, r) = load_files(&[("scene.xml", &xml)], &[("spp", "3")], false);
+    let (_d, r) = load_files(
+        &[("scene.xml", xml.as_bytes())],
+        &options(&[("spp", "3")], false),
+    );
     assert_eq!(r.unwrap().desc.render.spp, 3);
 
     let e = load_err(&scene("\n  <integrator type=\"$kind\"/>"));
@@ -309,9 +271,11 @@ fn includes_and_references_resolve() {
              <rgb name="reflectance" value="0.8, 0.1 0.1"/></bsdf></bsdf>"#,
     );
     let (_d, r) = load_files(
-        &[("scene.xml", &main), ("materials.xml", &materials)],
-        &[],
-        false,
+        &[
+            ("scene.xml", main.as_bytes()),
+            ("materials.xml", materials.as_bytes()),
+        ],
+        &options(&[], false),
     );
     let desc = r.unwrap().desc;
     let mat = |name: &str| &desc.materials.iter().find(|m| m.name == name).unwrap().bsdf;
@@ -342,19 +306,23 @@ fn includes_and_references_resolve() {
         "{e}"
     );
     let (_d, r) = load_files(
-        &[("scene.xml", &scene("<include filename=\"scene.xml\"/>"))],
-        &[],
-        false,
+        &[(
+            "scene.xml",
+            scene("<include filename=\"scene.xml\"/>").as_bytes(),
+        )],
+        &options(&[], false),
     );
     assert!(r.unwrap_err().message.contains("nest too deep"));
     // An error inside an included file points into that file.
     let (_d, r) = load_files(
         &[
-            ("scene.xml", &scene("<include filename=\"bad.xml\"/>")),
-            ("bad.xml", &scene("<shape type=\"torus\"/>")),
+            (
+                "scene.xml",
+                scene("<include filename=\"bad.xml\"/>").as_bytes(),
+            ),
+            ("bad.xml", scene("<shape type=\"torus\"/>").as_bytes()),
         ],
-        &[],
-        false,
+        &options(&[], false),
     );
     let e = r.unwrap_err().to_string();
     assert!(e.contains("bad.xml:2:1:") && e.contains("torus"), "{e}");
@@ -369,7 +337,8 @@ fn twosided_and_mask_may_wrap_a_reference() {
            <bsdf type="twosided" id="ts"><ref id="inner"/></bsdf>
            <bsdf type="mask" id="m"><float name="opacity" value="0.3"/><ref id="inner"/></bsdf>
            <shape type="cube"><ref id="ts"/></shape>"#,
-    ));
+    ))
+    .desc;
     let mat = |name: &str| &desc.materials.iter().find(|m| m.name == name).unwrap().bsdf;
     match mat("ts") {
         BsdfDesc::Diffuse {
@@ -402,7 +371,7 @@ fn emitters_map_to_area_and_point_lights() {
            <emitter type="point"><point name="position" value="1, 2, 3"/>
              <rgb name="intensity" value="5"/></emitter>
            <emitter type="point"><transform name="to_world"><translate x="4"/></transform></emitter>"#,
-    ));
+    )).desc;
     assert_eq!(desc.shapes[0].emission, Some(Vec3::new(1.0, 2.0, 3.0)));
     assert!(desc.shapes[0].flip_normals);
     let points: Vec<_> = desc
@@ -436,7 +405,7 @@ fn an_emitters_constant_spectrum_is_equal_energy_white_as_in_mitsubas_rgb_mode()
            <emitter type="point"><spectrum name="intensity" value="3"/></emitter>
            <emitter type="point"><rgb name="intensity" value="3"/></emitter>
            <emitter type="constant"><spectrum name="radiance" value="0.5"/></emitter>"#,
-    ));
+    )).desc;
     assert_close(desc.shapes[0].emission.unwrap(), 2.0 * e, 1e-6);
     assert_eq!(desc.shapes[1].emission, Some(Vec3::splat(2.0)));
     let bsdf = &desc
@@ -497,7 +466,7 @@ fn spectra_given_as_wavelength_pairs_reduce_to_mitsubas_rgb() {
            <shape type="cube"><bsdf type="conductor"><spectrum name="eta" value="{s}"/><spectrum name="k" value="{c}"/></bsdf></shape>
            <emitter type="point"><spectrum name="intensity" value="{s}"/></emitter>
            <emitter type="point"><spectrum name="intensity" value="{c}"/></emitter>"#
-    )));
+    ))).desc;
     let inner = |i: usize| {
         let name = &desc.shapes[i].material;
         match &desc
@@ -547,7 +516,10 @@ fn spectra_given_as_wavelength_pairs_reduce_to_mitsubas_rgb() {
         r#"<shape type="cube"><bsdf type="diffuse"><spectrum name="reflectance" filename="r.spd"/></bsdf></shape>
            <emitter type="point"><spectrum name="intensity" filename="r.spd"/></emitter>"#,
     );
-    let (_dir, loaded) = load_files(&[("scene.xml", &xml), ("r.spd", spd)], &[], false);
+    let (_dir, loaded) = load_files(
+        &[("scene.xml", xml.as_bytes()), ("r.spd", spd.as_bytes())],
+        &options(&[], false),
+    );
     let desc = loaded.unwrap().desc;
     let BsdfDesc::OneSided(inner) = &desc.materials[0].bsdf else {
         panic!()
@@ -620,9 +592,12 @@ fn meshes_without_normals_are_smoothed_as_mitsuba_does() {
              <boolean name="face_normals" value="true"/></shape>"#,
     );
     let (_d, r) = load_files(
-        &[("scene.xml", &xml), ("quad.obj", obj), ("tetra.ply", ply)],
-        &[],
-        false,
+        &[
+            ("scene.xml", xml.as_bytes()),
+            ("quad.obj", obj.as_bytes()),
+            ("tetra.ply", ply.as_bytes()),
+        ],
+        &options(&[], false),
     );
     let desc = r.unwrap().desc;
     let normals = |i: usize| match &desc.shapes[i].geometry {
@@ -650,7 +625,8 @@ fn cylinders_are_open_tubes_with_mitsubas_frame_and_uvs() {
         r#"<shape type="cylinder"><point name="p0" x="1" y="2" z="3"/>
              <point name="p1" x="1" y="2" z="5"/><float name="radius" value="0.5"/></shape>
            <shape type="cylinder"/>"#,
-    ));
+    ))
+    .desc;
     let mesh = |i: usize| match &desc.shapes[i].geometry {
         GeometryDesc::Mesh(m) => m.clone(),
         g => panic!("{g:?}"),
@@ -707,7 +683,10 @@ fn meshes_load_with_face_normals_and_flipped_uvs() {
              <boolean name="face_normals" value="true"/>
              <boolean name="flip_tex_coords" value="false"/></shape>"#,
     );
-    let (_d, r) = load_files(&[("scene.xml", &xml), ("tri.obj", obj)], &[], false);
+    let (_d, r) = load_files(
+        &[("scene.xml", xml.as_bytes()), ("tri.obj", obj.as_bytes())],
+        &options(&[], false),
+    );
     let desc = r.unwrap().desc;
     let mesh = |i: usize| match &desc.shapes[i].geometry {
         GeometryDesc::Mesh(m) => m.clone(),
@@ -736,7 +715,7 @@ fn render_settings_follow_film_sampler_and_integrator() {
                <integer name="seed" value="9"/></sampler>
              <film type="hdrfilm"><integer name="width" value="30"/><integer name="height" value="20"/>
                <rfilter type="box"/></film></sensor>"#,
-    ));
+    )).desc;
     let r = desc.render;
     assert_eq!(
         (r.width, r.height, r.spp, r.seed, r.max_depth, r.rr_depth),
@@ -748,13 +727,13 @@ fn render_settings_follow_film_sampler_and_integrator() {
     let (_dir, loaded) = load_files(
         &[(
             "scene.xml",
-            &scene(
+            scene(
                 r#"<sensor type="perspective"><float name="fov" value="40"/>
                      <sampler type="ldsampler"/></sensor>"#,
-            ),
+            )
+            .as_bytes(),
         )],
-        &[],
-        false,
+        &options(&[], false),
     );
     let loaded = loaded.unwrap();
     assert_eq!(loaded.desc.render.sampler, SamplerKind::SobolCmj);
@@ -770,9 +749,9 @@ fn render_settings_follow_film_sampler_and_integrator() {
             .map(|w| w.to_string())
             .collect::<Vec<_>>()
     );
-    assert_eq!(load(&scene("")).render.sampler, SamplerKind::default());
+    assert_eq!(load(&scene("")).desc.render.sampler, SamplerKind::default());
     // Without an integrator, Mitsuba's default path tracer has unlimited depth.
-    assert_eq!(load(&scene("")).render.max_depth, 1024);
+    assert_eq!(load(&scene("")).desc.render.max_depth, 1024);
     use candela_scene::mitsuba::candela_max_depth;
     assert_eq!(candela_max_depth(1), Ok(0));
     assert_eq!(candela_max_depth(2), Ok(1));
@@ -787,7 +766,7 @@ fn render_settings_follow_film_sampler_and_integrator() {
     );
     // Both count scattering events, so rr_depth carries over as it is; Mitsuba's default
     // is Candela's.
-    assert_eq!(load(&scene("")).render.rr_depth, 5);
+    assert_eq!(load(&scene("")).desc.render.rr_depth, 5);
     let e = load_err(&scene(
         "<integrator type=\"path\"><integer name=\"rr_depth\" value=\"-1\"/></integrator>",
     ));
@@ -811,37 +790,32 @@ fn integrators_with_the_path_tracers_expectation_render_as_it() {
         ("prb_basic", 5),
         ("direct", 1),
     ] {
-        let r = load(&scene(&format!(r#"<integrator type="{kind}"/>"#))).render;
+        let r = load(&scene(&format!(r#"<integrator type="{kind}"/>"#)))
+            .desc
+            .render;
         assert_eq!(
             (r.max_depth, r.rr_depth, r.hide_emitters),
             (depth, 5, false),
             "{kind}"
         );
     }
-    let (_dir, loaded) = load_files(
-        &[(
-            "scene.xml",
-            &scene(
+    let (_dir, loaded) = load_files(&[("scene.xml", scene(
                 r#"<integrator type="volpath"><integer name="max_depth" value="4"/>
                      <integer name="rr_depth" value="2"/><boolean name="hide_emitters" value="true"/></integrator>"#,
-            ),
-        )],
-        &[],
-        false,
-    );
+            ).as_bytes())], &options(&[], false));
     let r = loaded.unwrap().desc.render;
     assert_eq!((r.max_depth, r.rr_depth, r.hide_emitters), (3, 2, true));
     // direct's sample counts change the noise only: read, and warned of.
     let (_dir, loaded) = load_files(
         &[(
             "scene.xml",
-            &scene(
+            scene(
                 r#"<integrator type="direct"><integer name="emitter_samples" value="4"/>
                      <integer name="bsdf_samples" value="1"/></integrator>"#,
-            ),
+            )
+            .as_bytes(),
         )],
-        &[],
-        false,
+        &options(&[], false),
     );
     let loaded = loaded.unwrap();
     assert_eq!(loaded.desc.render.max_depth, 1);
@@ -893,7 +867,7 @@ fn unsupported_elements_are_errors_naming_them_or_warnings_when_lenient() {
         let e = load_err(&xml);
         assert!(e.contains(what), "{e}");
         assert!(e.contains("scene.xml:2:"), "{e}");
-        let (_d, r) = load_files(&[("scene.xml", &xml)], &[], true);
+        let (_d, r) = load_files(&[("scene.xml", xml.as_bytes())], &options(&[], true));
         let loaded = r.unwrap_or_else(|e| panic!("lenient: {e}"));
         assert!(
             loaded
@@ -922,7 +896,7 @@ fn version_0_6_scenes_are_upgraded_as_mitsuba_3_does() {
                <float name="extIOR" value="1"/></bsdf></shape>
              <shape type="cube"><bsdf type="diffuse"><rgb name="diffuseReflectance" value="0.3"/></bsdf></shape>
            </scene>"#,
-    );
+    ).desc;
     assert_eq!((desc.render.max_depth, desc.render.spp), (2, 9));
     assert_eq!(desc.camera.position, Vec3::X);
     assert!((desc.camera.fov_y_deg - 40.0).abs() < 1e-4);
@@ -1018,7 +992,7 @@ fn one_sided_diffuse_is_black_from_behind_as_in_mitsuba() {
                <emitter type="point"><point name="position" x="0" y="0" z="{}"/>
                  <rgb name="intensity" value="10"/></emitter>"#,
             z * 0.4
-        )));
+        ))).desc;
         let scene = candela_core::build::build(&desc).unwrap();
         let cancel = std::sync::atomic::AtomicBool::new(false);
         let film =
@@ -1049,7 +1023,7 @@ fn thin_lens_rays_focus_where_mitsuba_focuses() {
              <transform name="to_world"><lookat origin="1,2,3" target="0,0,0" up="0,1,0"/></transform>
              <film type="hdrfilm"><integer name="width" value="200"/><integer name="height" value="100"/></film>
            </sensor>"#,
-    ));
+    )).desc;
     let cam = Camera::new(&desc.camera, 200, 100);
     let (eye, fwd) = (
         Vec3::new(1.0, 2.0, 3.0),
@@ -1097,7 +1071,7 @@ fn the_example_scene_loads_cleanly_and_builds() {
 fn clip_planes_that_would_cut_the_scene_are_warned_of() {
     let warnings = |props: &str| {
         let xml = scene(&format!(r#"<sensor type="perspective">{props}</sensor>"#));
-        let (_dir, r) = load_files(&[("scene.xml", &xml)], &[], false);
+        let (_dir, r) = load_files(&[("scene.xml", xml.as_bytes())], &options(&[], false));
         let loaded = r.unwrap_or_else(|e| panic!("{e}"));
         loaded
             .warnings
@@ -1167,7 +1141,7 @@ fn textured_disks_carry_mitsubas_polar_uvs() {
     let desc = load(&scene(
         r#"<shape type="disk"><bsdf type="diffuse"><texture type="checkerboard" name="reflectance"/></bsdf></shape>
            <shape type="disk"><transform name="to_world"><translate z="-5"/></transform></shape>"#,
-    ));
+    )).desc;
     assert!(matches!(desc.shapes[0].geometry, GeometryDesc::Mesh(_)));
     assert!(matches!(desc.shapes[1].geometry, GeometryDesc::Disk));
     let scene = candela_core::build::build(&desc).unwrap();

@@ -8,44 +8,16 @@ use candela_core::bsdf::{Conductor, Dielectric, Lobe, Microfacet};
 use candela_core::build::{build, build_texture};
 use candela_core::desc::*;
 use candela_core::geometry::Ray;
-use candela_scene::{load_scene_with, LoadOptions, LoadedScene};
+use candela_scene::{load_scene_with, LoadOptions};
+use candela_test_support::assert_close;
+use candela_test_support::files::{load_files, options};
+use candela_test_support::mitsuba::{load, load_err, scene};
 use glam::{Vec2, Vec3};
-
-/// Writes `files` (name, bytes) into a fresh folder and loads the first.
-fn load_files(files: &[(&str, &[u8])], lenient: bool) -> Result<LoadedScene, String> {
-    let dir = tempfile::tempdir().unwrap();
-    for (name, bytes) in files {
-        std::fs::write(dir.path().join(name), bytes).unwrap();
-    }
-    let options = LoadOptions {
-        lenient,
-        ..Default::default()
-    };
-    load_scene_with(&dir.path().join(files[0].0), &options).map_err(|e| e.to_string())
-}
-
-fn scene(body: &str) -> String {
-    format!("<scene version=\"3.0.0\">\n{body}\n</scene>")
-}
-
-fn load(body: &str) -> LoadedScene {
-    load_files(&[("scene.xml", scene(body).as_bytes())], false).unwrap_or_else(|e| panic!("{e}"))
-}
-
-fn load_err(body: &str) -> String {
-    let e = load_files(&[("scene.xml", scene(body).as_bytes())], false).expect_err("should fail");
-    assert!(e.contains("scene.xml:"), "{e}");
-    e
-}
 
 /// The BSDF of the only material.
 fn bsdf(body: &str) -> BsdfDesc {
-    let desc = load(&format!("<shape type=\"cube\">{body}</shape>")).desc;
+    let desc = load(&scene(&format!("<shape type=\"cube\">{body}</shape>"))).desc;
     desc.materials[0].bsdf.clone()
-}
-
-fn assert_close(a: Vec3, b: Vec3, tol: f32) {
-    assert!((a - b).abs().max_element() < tol, "{a} vs {b}");
 }
 
 /// Mitsuba 3.9.1's RGB (η, k) of its `Cu` conductor: `mi.traverse(mi.load_dict({'type':
@@ -154,7 +126,7 @@ fn conductors_take_presets_or_eta_and_k_and_are_one_sided() {
             MicrofacetDesc::Ggx,
         ),
     ] {
-        let loaded = load(&format!(r#"<shape type="cube">{body}</shape>"#));
+        let loaded = load(&scene(&format!(r#"<shape type="cube">{body}</shape>"#)));
         assert_eq!(distribution(&loaded.desc.materials[0].bsdf), want, "{body}");
         assert!(loaded.warnings.is_empty(), "{body}: {:?}", loaded.warnings);
         // And the build renders it with that distribution.
@@ -179,10 +151,10 @@ fn conductors_take_presets_or_eta_and_k_and_are_one_sided() {
         );
     }
     // An unknown distribution is an error at the property's position.
-    let e = load_err(
+    let e = load_err(&scene(
         r#"<shape type="cube"><bsdf type="roughdielectric">
            <string name="distribution" value="phong"/></bsdf></shape>"#,
-    );
+    ));
     assert!(
         e.contains("scene.xml:3:") && e.contains("unknown microfacet distribution \"phong\""),
         "{e}"
@@ -209,7 +181,7 @@ fn conductors_take_presets_or_eta_and_k_and_are_one_sided() {
             "\"specular_reflectance\" other than 1 is not supported",
         ),
     ] {
-        let e = load_err(&format!("<shape type=\"cube\">{body}</shape>"));
+        let e = load_err(&scene(&format!("<shape type=\"cube\">{body}</shape>")));
         assert!(e.contains(what), "{e}");
     }
 }
@@ -228,7 +200,7 @@ fn a_conductors_specular_reflectance_scales_its_fresnel_term() {
         BsdfDesc::Conductor { specular, .. } => assert_eq!(*specular, scale),
         other => panic!("{other:?}"),
     }
-    let scene = build(&load(&format!("<shape type=\"cube\">{body}</shape>")).desc).unwrap();
+    let scene = build(&load(&scene(&format!("<shape type=\"cube\">{body}</shape>"))).desc).unwrap();
     let scaled = match &scene.materials[0] {
         candela_core::material::Material::Fixed(Lobe::Conductor(c)) => *c,
         other => panic!("{other:?}"),
@@ -297,7 +269,7 @@ fn dielectrics_read_numbers_and_named_indices() {
             "specular_reflectance",
         ),
     ] {
-        let e = load_err(&format!("<shape type=\"cube\">{body}</shape>"));
+        let e = load_err(&scene(&format!("<shape type=\"cube\">{body}</shape>")));
         assert!(e.contains(what), "{e}");
     }
 }
@@ -327,10 +299,10 @@ fn a_dielectrics_specular_transmittance_is_its_tint() {
         TextureDesc::Constant(c) => assert_eq!(c, Vec3::ONE),
         t => panic!("{t:?}"),
     }
-    let e = load_err(
+    let e = load_err(&scene(
         r#"<shape type="cube"><bsdf type="thindielectric">
              <rgb name="specular_transmittance" value="0.5"/></bsdf></shape>"#,
-    );
+    ));
     assert!(
         e.contains("scene.xml:3:14:") && e.contains("\"specular_transmittance\" other than 1"),
         "{e}"
@@ -395,15 +367,15 @@ fn plastics_become_candelas_plastic_smooth_or_rough_linear_or_not() {
         matches!(*inner, BsdfDesc::Plastic { specular, .. } if specular == Vec3::new(0.2, 0.5, 0.9)),
         "{inner:?}"
     );
-    let e = load_err(
+    let e = load_err(&scene(
         r#"<shape type="cube"><bsdf type="plastic">
              <float name="alpha" value="0.2"/></bsdf></shape>"#,
-    );
+    ));
     assert!(e.contains("scene.xml:3:") && e.contains("alpha"), "{e}");
-    let e = load_err(
+    let e = load_err(&scene(
         r#"<shape type="cube"><bsdf type="roughplastic">
              <float name="alpha_u" value="0.2"/><float name="alpha_v" value="0.1"/></bsdf></shape>"#,
-    );
+    ));
     assert!(e.contains("scene.xml:2:") && e.contains("one alpha"), "{e}");
 }
 
@@ -503,7 +475,7 @@ fn a_rough_plastic_evaluates_close_to_mitsubas_roughplastic() {
             r#"<shape type="cube"><bsdf type="roughplastic">{props}
                <rgb name="diffuse_reflectance" value="0.7, 0.3, 0.1"/></bsdf></shape>"#
         );
-        let scene = build(&load(&body).desc).unwrap();
+        let scene = build(&load(&scene(&body)).desc).unwrap();
         let bsdf = scene.materials[0].bsdf(Vec3::Z, Vec3::Z, Vec2::ZERO);
         for ((wo, wi), want) in pairs.iter().zip(want) {
             let (wo, wi) = (Vec3::from(*wo).normalize(), Vec3::from(*wi).normalize());
@@ -551,7 +523,13 @@ fn a_linear_bitmap_plastic_divides_each_lookup_by_one_minus_f_dr() {
            </bsdf></shape>"#,
     );
     let png = png_2x2();
-    let loaded = load_files(&[("scene.xml", x.as_bytes()), ("t.png", &png)], false).unwrap();
+    let loaded = load_files(
+        &[("scene.xml", x.as_bytes()), ("t.png", &png)],
+        &options(&[], false),
+    )
+    .1
+    .map_err(|e| e.to_string())
+    .unwrap();
     let scene = build(&loaded.desc).unwrap();
     let fdr = fresnel_diffuse_reflectance(1.0 / 1.5);
     let srgb_128 = 0.215_861;
@@ -585,8 +563,13 @@ fn bitmaps_are_looked_up_as_mitsuba_does() {
     };
     let load_tex = |extra: &str| {
         let x = xml(extra);
-        let loaded = load_files(&[("scene.xml", x.as_bytes()), ("t.png", &png)], false)
-            .unwrap_or_else(|e| panic!("{e}"));
+        let loaded = load_files(
+            &[("scene.xml", x.as_bytes()), ("t.png", &png)],
+            &options(&[], false),
+        )
+        .1
+        .map_err(|e| e.to_string())
+        .unwrap_or_else(|e| panic!("{e}"));
         albedo(&loaded.desc)
     };
     // Mitsuba's uv (0, 0) is the image's top-left texel: red. sRGB 128 is 0.2158 linear.
@@ -635,9 +618,18 @@ fn bitmaps_are_looked_up_as_mitsuba_does() {
         1e-4,
     );
     let x = xml(r#"<string name="wrap_mode" value="spiral"/>"#);
-    let e = load_files(&[("scene.xml", x.as_bytes()), ("t.png", &png)], false).unwrap_err();
+    let e = load_files(
+        &[("scene.xml", x.as_bytes()), ("t.png", &png)],
+        &options(&[], false),
+    )
+    .1
+    .map_err(|e| e.to_string())
+    .unwrap_err();
     assert!(e.contains("spiral") && e.contains("scene.xml:3:"), "{e}");
-    let e = load_files(&[("scene.xml", xml("").as_bytes())], false).unwrap_err();
+    let e = load_files(&[("scene.xml", xml("").as_bytes())], &options(&[], false))
+        .1
+        .map_err(|e| e.to_string())
+        .unwrap_err();
     assert!(e.contains("t.png"), "{e}");
 }
 
@@ -645,10 +637,10 @@ fn bitmaps_are_looked_up_as_mitsuba_does() {
 fn checkerboards_and_texture_references() {
     // Mitsuba's checkerboard: colour0 where the fractional parts of u and v are on the
     // same side of ½ (its `checkerboard.cpp`); defaults 0.4 and 0.2.
-    let loaded = load(
+    let loaded = load(&scene(
         r#"<texture type="checkerboard" id="checks"><rgb name="color1" value="0.9, 0.1, 0.1"/></texture>
            <shape type="cube"><bsdf type="diffuse"><ref name="reflectance" id="checks"/></bsdf></shape>"#,
-    );
+    ));
     let t = albedo(&loaded.desc);
     let (c0, c1) = (Vec3::splat(0.4), Vec3::new(0.9, 0.1, 0.1));
     for (uv, c) in [
@@ -661,11 +653,11 @@ fn checkerboards_and_texture_references() {
     ] {
         assert_eq!(t.eval(Vec2::new(uv.0, uv.1)), c, "at {uv:?}");
     }
-    let e = load_err(
+    let e = load_err(&scene(
         r#"<shape type="cube"><bsdf type="diffuse"><ref name="reflectance" id="nope"/></bsdf></shape>"#,
-    );
+    ));
     assert!(e.contains("nope"), "{e}");
-    let e = load_err(r#"<texture type="checkerboard"/>"#);
+    let e = load_err(&scene(r#"<texture type="checkerboard"/>"#));
     assert!(e.contains("needs an id"), "{e}");
 }
 
@@ -683,14 +675,14 @@ fn textured_spheres_carry_mitsubas_uvs() {
                <translate x="1" y="2" z="3"/></transform></shape>"#
         )
     };
-    let plain = load(&shape("")).desc;
+    let plain = load(&scene(&shape(""))).desc;
     assert!(matches!(
         plain.shapes[0].geometry,
         GeometryDesc::Sphere { .. }
     ));
-    let desc = load(&shape(
+    let desc = load(&scene(&shape(
         r#"<bsdf type="diffuse"><texture type="checkerboard" name="reflectance"/></bsdf>"#,
-    ))
+    )))
     .desc;
     assert!(matches!(desc.shapes[0].geometry, GeometryDesc::Mesh(_)));
     let scene = build(&desc).unwrap();
@@ -721,7 +713,7 @@ fn textured_spheres_carry_mitsubas_uvs() {
 
 /// The one light of a scene.
 fn light(body: &str) -> LightKindDesc {
-    let desc = load(body).desc;
+    let desc = load(&scene(body)).desc;
     assert_eq!(desc.lights.len(), 1);
     desc.lights[0].kind.clone()
 }
@@ -746,9 +738,9 @@ fn spot_and_directional_emitters_map_with_mitsubas_defaults() {
         }
         other => panic!("{other:?}"),
     }
-    let e = load_err(
+    let e = load_err(&scene(
         r#"<emitter type="spot"><float name="cutoff_angle" value="10"/><float name="beam_width" value="20"/></emitter>"#,
-    );
+    ));
     assert!(e.contains("beam_width"), "{e}");
     match light(
         r#"<emitter type="directional"><vector name="direction" value="0, -1, 0"/>
@@ -897,24 +889,27 @@ fn envmaps_face_where_mitsuba_faces_them() {
             assert_close(le, 2.0 * Vec3::new(red, 2.5, 1.0), 1e-3);
         }
     }
-    let e = load_err(
+    let e = load_err(&scene(
         r#"<emitter type="envmap"><string name="filename" value="missing.exr"/></emitter>"#,
-    );
+    ));
     assert!(e.contains("missing.exr"), "{e}");
 }
 
 #[test]
 fn constant_emitters_and_hidden_emitters() {
-    let desc =
-        load(r#"<emitter type="constant"><rgb name="radiance" value="0.5, 0.25, 1"/></emitter>"#)
-            .desc;
-    let scene = build(&desc).unwrap();
-    let env = scene.light(scene.infinite_lights[0]);
+    let desc = load(&scene(
+        r#"<emitter type="constant"><rgb name="radiance" value="0.5, 0.25, 1"/></emitter>"#,
+    ))
+    .desc;
+    let built = build(&desc).unwrap();
+    let env = built.light(built.infinite_lights[0]);
     assert_eq!(
         env.le(&Ray::new(Vec3::ZERO, Vec3::Y)),
         Vec3::new(0.5, 0.25, 1.0)
     );
-    let e = load_err(r#"<emitter type="constant"/><emitter type="constant"/>"#);
+    let e = load_err(&scene(
+        r#"<emitter type="constant"/><emitter type="constant"/>"#,
+    ));
     assert!(e.contains("at most one"), "{e}");
 
     // Mitsuba 3.9.1: rectangle scaled 0.5 with area radiance 3 and no BSDF, constant sky
@@ -937,11 +932,11 @@ fn constant_emitters_and_hidden_emitters() {
         )
     };
     for (hide, centre, corner) in [(false, 3.0, 0.5), (true, 0.0, 0.0)] {
-        let desc = load(&body(hide)).desc;
+        let desc = load(&scene(&body(hide))).desc;
         assert_eq!(desc.render.hide_emitters, hide);
-        let scene = build(&desc).unwrap();
+        let built = build(&desc).unwrap();
         let spp = desc.render.spp;
-        let r = candela_core::integrator::render(&scene, 0..spp, &AtomicBool::new(false), &|_| {});
+        let r = candela_core::integrator::render(&built, 0..spp, &AtomicBool::new(false), &|_| {});
         let img = r.film.resolve();
         let px = |x: usize, y: usize| img[y * 16 + x];
         assert_close(px(8, 8), Vec3::splat(centre), 1e-4);
@@ -975,7 +970,7 @@ fn masks_become_stochastic_alpha_and_normalmaps_get_mitsubas_bitangent() {
         r#"<bsdf type="mask"><texture type="checkerboard" name="opacity"/><bsdf type="diffuse"/></bsdf>"#,
     ));
     assert!(matches!(a.texture, Some(TextureDesc::Checker { .. })) && a.factor == 1.0);
-    let e = load_err(r#"<shape type="cube"><bsdf type="mask"/></shape>"#);
+    let e = load_err(&scene(r#"<shape type="cube"><bsdf type="mask"/></shape>"#));
     assert!(
         e.contains("scene.xml:2:20:") && e.contains("one nested <bsdf>"),
         "{e}"
@@ -994,8 +989,10 @@ fn masks_become_stochastic_alpha_and_normalmaps_get_mitsubas_bitangent() {
     );
     let desc = load_files(
         &[("scene.xml", xml.as_bytes()), ("quad.obj", obj.as_bytes())],
-        false,
+        &options(&[], false),
     )
+    .1
+    .map_err(|e| e.to_string())
     .unwrap()
     .desc;
     match &desc.materials[0].bsdf {
@@ -1017,9 +1014,9 @@ fn masks_become_stochastic_alpha_and_normalmaps_get_mitsubas_bitangent() {
         mesh(1).tangents.is_empty(),
         "only normal-mapped meshes get tangents"
     );
-    let e = load_err(
+    let e = load_err(&scene(
         r#"<shape type="cube"><bsdf type="normalmap"><bsdf type="diffuse"/></bsdf></shape>"#,
-    );
+    ));
     assert!(
         e.contains("scene.xml:2:20:") && e.contains("normalmap needs"),
         "{e}"
@@ -1055,12 +1052,12 @@ fn blendbsdfs_become_mixes_of_their_two_bsdfs_in_order() {
     // References, in their order; an RGB weight is its mean (Mitsuba 3.9.1, scalar_rgb:
     // a blend of white and black diffuse with weight (0.2, 0.5, 0.9) evaluates to
     // 0.46667/π towards the normal, so w = 0.53333).
-    let desc = load(
+    let desc = load(&scene(
         r#"<bsdf type="diffuse" id="d"/><bsdf type="roughconductor" id="c"/>
            <bsdf type="blendbsdf" id="m"><rgb name="weight" value="0.2, 0.5, 0.9"/>
              <ref id="c"/><ref id="d"/></bsdf>
            <shape type="cube"><ref id="m"/></shape>"#,
-    )
+    ))
     .desc;
     let m = desc.materials.iter().find(|m| m.name == "m").unwrap();
     let (w, a, b) = mix(m.bsdf.clone());
@@ -1072,12 +1069,12 @@ fn blendbsdfs_become_mixes_of_their_two_bsdfs_in_order() {
     build(&desc).expect("a blend builds");
     // A twosided around a <ref> to the blend makes both its BSDFs two-sided, as a blend
     // nested in the twosided would be.
-    let desc = load(
+    let desc = load(&scene(
         r#"<bsdf type="blendbsdf" id="m"><float name="weight" value="0.5"/>
              <bsdf type="diffuse"/><bsdf type="normalmap"><texture type="checkerboard" name="normalmap"/>
                <bsdf type="conductor"/></bsdf></bsdf>
            <shape type="cube"><bsdf type="twosided"><ref id="m"/></bsdf></shape>"#,
-    )
+    ))
     .desc;
     let shape_material = &desc.shapes[0].material;
     let m = desc
@@ -1112,7 +1109,13 @@ fn blend_weights_and_mask_opacities_read_a_bitmap_as_its_luminance() {
                  <texture type="bitmap" name="{slot}"><string name="filename" value="t.png"/></texture>
                  <bsdf type="diffuse"/>{second}</bsdf></shape>"#
         ));
-        let loaded = load_files(&[("scene.xml", x.as_bytes()), ("t.png", &png)], false).unwrap();
+        let loaded = load_files(
+            &[("scene.xml", x.as_bytes()), ("t.png", &png)],
+            &options(&[], false),
+        )
+        .1
+        .map_err(|e| e.to_string())
+        .unwrap();
         let texture = match &loaded.desc.materials[0].bsdf {
             BsdfDesc::Mix { weight, .. } => weight.clone(),
             BsdfDesc::Alpha { alpha, .. } => alpha.texture.clone().unwrap(),
@@ -1177,14 +1180,14 @@ fn a_blendbsdf_without_a_weight_or_two_bsdfs_is_an_error_at_its_place() {
             "scene.xml:2:20: blendbsdf needs exactly two nested <bsdf> or <ref>, not 1",
         ),
     ] {
-        let e = load_err(body);
+        let e = load_err(&scene(body));
         assert!(e.contains(what), "{e}");
     }
     // A mask belongs around the blend: inside it, it would have to blend coverage.
-    let desc = load(
+    let desc = load(&scene(
         r#"<shape type="cube"><bsdf type="blendbsdf"><float name="weight" value="0.5"/>
              <bsdf type="mask"><bsdf type="diffuse"/></bsdf><bsdf type="diffuse"/></bsdf></shape>"#,
-    )
+    ))
     .desc;
     let e = build(&desc).map(|_| ()).unwrap_err().to_string();
     assert!(
@@ -1209,9 +1212,15 @@ fn unknown_plugins_name_themselves() {
             "<emitter type=\"sunsky\"> is not supported",
         ),
     ] {
-        let e = load_err(body);
+        let e = load_err(&scene(body));
         assert!(e.contains(what) && e.contains("scene.xml:2:"), "{e}");
-        let loaded = load_files(&[("scene.xml", scene(body).as_bytes())], true).unwrap();
+        let loaded = load_files(
+            &[("scene.xml", scene(body).as_bytes())],
+            &options(&[], true),
+        )
+        .1
+        .map_err(|e| e.to_string())
+        .unwrap();
         assert!(
             loaded.warnings.iter().any(|w| w.contains(what)),
             "{:?}",
@@ -1228,7 +1237,7 @@ fn max_depth_counts_as_in_mitsuba() {
     // Candela must agree within 4 standard errors of its pixel mean (two-sided, p ≈ 6e-5
     // per depth).
     for m in 1..=4 {
-        let desc = load(&format!(
+        let desc = load(&scene(&format!(
             r#"<integrator type="path"><integer name="max_depth" value="{m}"/></integrator>
                <sensor type="perspective"><float name="fov" value="60"/>
                  <transform name="to_world"><lookat origin="0, 0, 0" target="0, 0, -1" up="0, 1, 0"/></transform>
@@ -1238,7 +1247,7 @@ fn max_depth_counts_as_in_mitsuba() {
                <shape type="sphere"><boolean name="flip_normals" value="true"/>
                  <bsdf type="twosided"><bsdf type="diffuse"><rgb name="reflectance" value="0.5"/></bsdf></bsdf>
                  <emitter type="area"><rgb name="radiance" value="1"/></emitter></shape>"#
-        ))
+        )))
         .desc;
         let scene = build(&desc).unwrap();
         let r = candela_core::integrator::render(&scene, 0..256, &AtomicBool::new(false), &|_| {});
@@ -1257,9 +1266,9 @@ fn max_depth_counts_as_in_mitsuba() {
 #[test]
 fn pixel_filters_follow_the_film() {
     let filter = |rfilter: &str| {
-        load(&format!(
+        load(&scene(&format!(
             r#"<sensor type="perspective"><float name="fov" value="40"/><film type="hdrfilm">{rfilter}</film></sensor>"#
-        ))
+        )))
         .desc
         .render
         .filter
@@ -1284,13 +1293,13 @@ fn pixel_filters_follow_the_film() {
             radius: 1.0
         }
     );
-    let e = load_err(
+    let e = load_err(&scene(
         r#"<sensor type="perspective"><float name="fov" value="40"/><film type="hdrfilm"><rfilter type="tent"><float name="radius" value="0"/></rfilter></film></sensor>"#,
-    );
+    ));
     assert!(e.contains("radius must be positive"), "{e}");
-    let e = load_err(
+    let e = load_err(&scene(
         r#"<sensor type="perspective"><float name="fov" value="40"/><film type="hdrfilm"><rfilter type="lanczos"/></film></sensor>"#,
-    );
+    ));
     assert!(
         e.contains("<rfilter type=\"lanczos\"> is not supported"),
         "{e}"

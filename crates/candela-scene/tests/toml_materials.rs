@@ -29,7 +29,7 @@ fn every_material_type_parses() {
     else {
         panic!()
     };
-    let (au_eta, au_k) = candela_core::bsdf::metal_preset("Au").unwrap();
+    let (au_eta, au_k) = candela_core::desc::metal_preset("Au").unwrap();
     assert_eq!((eta, k, alpha_u, alpha_v), (au_eta, au_k, 0.1, 0.3));
     let BsdfDesc::Conductor { eta, alpha_u, .. } =
         material("type = \"conductor\"\neta = [0.2, 0.9, 1.1]\nk = 3\nalpha = 0.05").unwrap()

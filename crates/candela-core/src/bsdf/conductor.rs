@@ -93,45 +93,10 @@ impl Conductor {
     }
 }
 
-/// Named metals: (name, η, k) in linear Rec.709 RGB, relative to air. These are the RGB
-/// reductions of measured spectral data that Tungsten tabulates (`ComplexIorData.hpp`,
-/// from the spectra Mitsuba 0.5 ships, after Palik's *Handbook of Optical Constants of
-/// Solids*); the spectral curves were reduced to RGB once, by their tables' authors.
-pub const METAL_PRESETS: [(&str, [f32; 3], [f32; 3]); 5] = [
-    (
-        "Au",
-        [0.143119, 0.374957, 1.44248],
-        [3.98316, 2.38572, 1.60322],
-    ),
-    (
-        "Ag",
-        [0.155265, 0.116723, 0.138342],
-        [4.82835, 3.12225, 2.14696],
-    ),
-    (
-        "Cu",
-        [0.200438, 0.924033, 1.10221],
-        [3.91295, 2.45285, 2.14219],
-    ),
-    (
-        "Al",
-        [1.65746, 0.880369, 0.521229],
-        [9.22387, 6.26952, 4.837],
-    ),
-    ("Cr", [4.36968, 2.9167, 1.6547], [5.20643, 4.23136, 3.75495]),
-];
-
-/// The (η, k) of a named metal from [`METAL_PRESETS`] (case-insensitive), for loaders.
-pub fn metal_preset(name: &str) -> Option<(Vec3, Vec3)> {
-    METAL_PRESETS
-        .iter()
-        .find(|(n, _, _)| n.eq_ignore_ascii_case(name))
-        .map(|(_, eta, k)| (Vec3::from(*eta), Vec3::from(*k)))
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::desc::metal_preset;
 
     #[test]
     fn presets_have_their_metals_colours() {

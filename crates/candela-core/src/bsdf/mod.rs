@@ -34,7 +34,7 @@ mod metal_rough;
 pub mod microfacet;
 mod plastic;
 
-pub use conductor::{metal_preset, Conductor, ConductorFresnel, METAL_PRESETS};
+pub use conductor::{Conductor, ConductorFresnel};
 pub use dielectric::{Dielectric, ThinDielectric};
 pub use diffuse::Diffuse;
 pub use metal_rough::MetalRough;

@@ -6,11 +6,10 @@ use candela_core::alpha::AlphaMode;
 use candela_core::math::luminance;
 
 use candela_core::desc::{
-    AlphaDesc, BsdfDesc, ImageDesc, MaterialDesc, MicrofacetDesc, TextureDesc,
+    conductor, AlphaDesc, BsdfDesc, ImageDesc, MaterialDesc, MicrofacetDesc, TextureDesc,
 };
 use glam::Vec3;
 
-use super::conductors::MITSUBA_CONDUCTORS;
 use super::parse::Node;
 use super::{describe, Ctx};
 use crate::LoadError;
@@ -358,8 +357,8 @@ fn conductor_ior(ctx: &mut Ctx, node: &Node) -> Result<(Vec3, Vec3), LoadError> 
         }
         // η = 0, k = 1 reflects everything at every angle: Mitsuba's "none".
         (Some("none"), None, None) | (None, None, None) => Ok((Vec3::ZERO, Vec3::ONE)),
-        (Some(name), None, None) => match MITSUBA_CONDUCTORS.iter().find(|c| c.0 == name) {
-            Some(&(_, eta, k)) => Ok((Vec3::from(eta), Vec3::from(k))),
+        (Some(name), None, None) => match conductor(name) {
+            Some(ior) => Ok(ior),
             None => {
                 let p = node.prop("material").expect("read just now");
                 ctx.unsupported(

@@ -7,7 +7,6 @@
 
 mod aov;
 mod bsdfs;
-mod conductors;
 mod emitters;
 mod media;
 mod parse;

@@ -5,8 +5,9 @@ use std::fmt;
 use std::path::Path;
 use std::sync::Arc;
 
-use candela_core::bsdf::metal_preset;
-use candela_core::desc::{BsdfDesc, ImageTextureDesc, MicrofacetDesc, TextureDesc, WrapMode};
+use candela_core::desc::{
+    metal_preset, BsdfDesc, ImageTextureDesc, MicrofacetDesc, TextureDesc, WrapMode, METAL_PRESETS,
+};
 use glam::{Affine2, Vec3};
 use serde::de::{self, IgnoredAny, MapAccess, Visitor};
 use serde::{Deserialize, Deserializer};
@@ -220,13 +221,12 @@ pub(crate) fn parse_material(
             let (alpha_u, alpha_v) = alpha(&m);
             let (eta, k) = match (m.preset, m.eta, m.k) {
                 (Some(p), None, None) => metal_preset(p.get_ref()).ok_or_else(|| {
-                    let names: Vec<&str> = candela_core::bsdf::METAL_PRESETS
-                        .iter()
-                        .map(|m| m.0)
-                        .collect();
                     src.error(
                         p.span().start,
-                        format!("unknown metal preset \"{}\"; known: {names:?}", p.get_ref()),
+                        format!(
+                            "unknown metal preset \"{}\"; known: {METAL_PRESETS:?}",
+                            p.get_ref()
+                        ),
                     )
                 })?,
                 (None, Some(eta), Some(k)) => (eta.get_ref().0, k.0),

@@ -1,5 +1,5 @@
-//! Comparing two estimators' renders tile by tile (`mis_consistency.rs`,
-//! `filter_splat.rs`): each render's mean luminance per square tile is one observation,
+//! Comparing two estimators' renders tile by tile (`candela-core`'s `mis_consistency` and
+//! `filter_splat` tests): each render's mean luminance per square tile is one observation,
 //! and Welch's t-test compares two sets of renders tile by tile.
 
 use candela_core::chi2::welch_p_samples;
@@ -17,6 +17,22 @@ pub fn push_tile_means(out: &mut [Vec<f64>], img: &[Vec3], res: u32, tile: u32) 
     for (t, s) in sums.iter().enumerate() {
         out[t].push(s / (tile * tile) as f64);
     }
+}
+
+/// Per tile (`tile` pixels square, of a `res` × `res` image), its mean luminance in each
+/// of `renders` independent renders, `render(k)` making render k (its pixels, row major).
+pub fn tile_means(
+    renders: u64,
+    res: u32,
+    tile: u32,
+    mut render: impl FnMut(u64) -> Vec<Vec3>,
+) -> Vec<Vec<f64>> {
+    let tiles = (res / tile) as usize;
+    let mut out = vec![Vec::new(); tiles * tiles];
+    for k in 0..renders {
+        push_tile_means(&mut out, &render(k), res, tile);
+    }
+    out
 }
 
 /// Tiles (index, p-value) whose Welch test rejects equality at `alpha`.

@@ -1,13 +1,24 @@
-//! The conductors Mitsuba 3 names in a `material` string, as (η, k) in linear Rec. 709
-//! RGB. Mitsuba stores them as spectra (its `data/ior` tables, mostly Palik's
-//! measurements); these are the RGB values its `scalar_rgb` variant (3.9.1) makes of them,
-//! read back through `mi.traverse` on `{'type': 'conductor', 'material': NAME}`, so an
-//! imported conductor reflects as it does in Mitsuba's RGB variants. Where Mitsuba clamps
-//! a channel that falls out of gamut to 0 (`AlSb`'s red η; the slightly negative green k
-//! of `AlAs`, `MgO`, `SiC` and `TiO2`), so does this table.
+//! Named conductors, as (η, k) in linear Rec. 709 RGB relative to air: the one table
+//! that every loader's presets read (TOML's `preset`, Mitsuba's `material`).
+//!
+//! The values are Mitsuba 3's. Mitsuba stores these conductors as spectra (its `data/ior`
+//! tables, mostly Palik's *Handbook of Optical Constants of Solids*); these are the RGB
+//! values its `scalar_rgb` variant (3.9.1) makes of them, read back through
+//! `mi.traverse` on `{'type': 'conductor', 'material': NAME}`. So an imported Mitsuba
+//! conductor reflects as it does in Mitsuba's RGB variants, and a TOML preset as the
+//! Mitsuba conductor of the same name. (The TOML presets once took Tungsten's reductions
+//! of the same Palik spectra, `ComplexIorData.hpp`, which differ in the fourth digit.)
+//! Where Mitsuba clamps a channel that falls out of gamut to 0 (`AlSb`'s red η; the
+//! slightly negative green k of `AlAs`, `MgO`, `SiC` and `TiO2`), so does this table.
+
+use glam::Vec3;
+
+/// The presets Candela's TOML format names (case-insensitive there), each a conductor of
+/// [`CONDUCTORS`].
+pub const METAL_PRESETS: [&str; 5] = ["Au", "Ag", "Cu", "Al", "Cr"];
 
 /// (name, η, k); the names are Mitsuba's, case and all.
-pub(crate) const MITSUBA_CONDUCTORS: &[(&str, [f32; 3], [f32; 3])] = &[
+pub const CONDUCTORS: &[(&str, [f32; 3], [f32; 3])] = &[
     (
         "a-C",
         [2.94405, 2.22714, 1.96816],
@@ -320,3 +331,46 @@ pub(crate) const MITSUBA_CONDUCTORS: &[(&str, [f32; 3], [f32; 3])] = &[
         [3.50064, 2.60487, 2.27323],
     ),
 ];
+
+/// The (η, k) of the conductor `name` as Mitsuba spells it (case and all), from
+/// [`CONDUCTORS`].
+pub fn conductor(name: &str) -> Option<(Vec3, Vec3)> {
+    CONDUCTORS
+        .iter()
+        .find(|(n, _, _)| *n == name)
+        .map(|(_, eta, k)| (Vec3::from(*eta), Vec3::from(*k)))
+}
+
+/// The (η, k) of the TOML preset `name` (one of [`METAL_PRESETS`], case-insensitive).
+pub fn metal_preset(name: &str) -> Option<(Vec3, Vec3)> {
+    let preset = METAL_PRESETS
+        .iter()
+        .find(|p| p.eq_ignore_ascii_case(name))?;
+    conductor(preset)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_preset_is_a_conductor_and_names_are_distinct() {
+        for p in METAL_PRESETS {
+            assert!(conductor(p).is_some(), "{p}");
+            assert_eq!(metal_preset(&p.to_lowercase()), conductor(p));
+        }
+        assert!(metal_preset("W").is_none(), "not a TOML preset");
+        assert!(
+            conductor("ag").is_none(),
+            "Mitsuba's names are case-sensitive"
+        );
+        let mut names: Vec<String> = CONDUCTORS.iter().map(|c| c.0.to_lowercase()).collect();
+        names.sort();
+        names.dedup();
+        assert_eq!(names.len(), CONDUCTORS.len());
+        // Mitsuba 3.9.1's silver, as `mi.traverse` gives it.
+        let (eta, k) = conductor("Ag").unwrap();
+        assert_eq!(eta, Vec3::new(0.155276, 0.116728, 0.138388));
+        assert_eq!(k, Vec3::new(4.82835, 3.12222, 2.1469));
+    }
+}

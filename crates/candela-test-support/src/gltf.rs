@@ -1,6 +1,5 @@
 //! Shared by the glTF tests: a small GLB writer (JSON + one binary buffer), so tests make
 //! their own files with exactly the features they check, and a JSON reader for GLB.
-#![allow(dead_code)]
 
 use serde_json::{json, Value};
 

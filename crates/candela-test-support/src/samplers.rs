@@ -1,8 +1,6 @@
 //! What the sampler tests share: drawing one request of one pixel sample, and the
 //! chi-square test of points over many pixels.
 
-#![allow(dead_code)]
-
 use candela_core::chi2::{sidak_alpha, ChiSquareTest};
 use candela_core::sampler::Sampler;
 use glam::{UVec2, Vec2};
@@ -14,6 +12,7 @@ pub enum Request {
     TwoD { skip: u32 },
 }
 
+/// The numbers of request `req` of sample `index` of `pixel` (a 1D request in x, y zero).
 pub fn draw<S: Sampler>(s: &mut S, pixel: UVec2, index: u32, req: Request) -> Vec2 {
     s.start_pixel_sample(pixel, index);
     match req {
@@ -32,6 +31,7 @@ pub fn draw<S: Sampler>(s: &mut S, pixel: UVec2, index: u32, req: Request) -> Ve
     }
 }
 
+/// [`draw`] for each sample index in `indices`.
 pub fn points<S: Sampler>(
     s: &mut S,
     pixel: UVec2,
