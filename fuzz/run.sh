@@ -5,9 +5,9 @@
 #   fuzz/run.sh TARGET 1000000   # for 10^6 executions (at most MAX_SECONDS, default 480)
 #
 # Targets are the files in fuzz/fuzz_targets/. Seeds are copied at run time from
-# ../shared/data and scenes/ into fuzz/corpus/TARGET (ignored by git); crashes, hangs
-# and out-of-memory inputs land in fuzz/artifacts/TARGET/. One job, one process: the
-# machine is shared. Extra arguments after the second go to libFuzzer.
+# ../shared/data, scenes/ and bench/scenes/ into fuzz/corpus/TARGET (ignored by git);
+# crashes, hangs and out-of-memory inputs land in fuzz/artifacts/TARGET/. One job, one
+# process: the machine is shared. Extra arguments after the second go to libFuzzer.
 set -euo pipefail
 
 usage() { echo "usage: fuzz/run.sh TARGET SECONDS's'|EXECS [libFuzzer args...]" >&2; exit 2; }
@@ -22,7 +22,7 @@ shared=${CANDELA_SHARED_DATA:-$repo/../shared/data}
 # Seeds: the project's own files and the shared real data of the target's kind. A
 # target's `seeds_NAME` function prints the files, one a line; the image target's seeds
 # are prefixed by the byte that picks their decoder (see fuzz_targets/image.rs).
-files() { for pattern in "$@"; do find "$repo/scenes" "$shared" -type f -name "$pattern" 2>/dev/null; done; }
+files() { for pattern in "$@"; do find "$repo/scenes" "$repo/bench/scenes" "$shared" -type f -name "$pattern" 2>/dev/null; done; }
 seeds_toml() { files '*.toml'; }
 seeds_obj() { files '*.obj'; }
 seeds_ply() { files '*.ply'; }
@@ -37,8 +37,14 @@ corpus=$here/corpus/$target
 artifacts=$here/artifacts/$target
 mkdir -p "$corpus" "$artifacts"
 if declare -f "seeds_$target" >/dev/null; then
-  "seeds_$target" | while read -r f; do cp "$f" "$corpus/seed-$(basename "$f")"; done
+  # Named with their folder too: the shared scenes are all called scene.xml.
+  "seeds_$target" | while read -r f; do cp "$f" "$corpus/seed-$(basename "$(dirname "$f")")-$(basename "$f")"; done
 fi
+# The scene targets read their input as a file in scenes/ (see src/lib.rs): the
+# benchmark scenes' paths into it (../../scenes/media/smoke.vol) are made relative to it.
+case $target in
+  toml|mitsuba) sed -i 's|\.\./\.\./scenes/||g' "$corpus"/seed-* ;;
+esac
 # Small hand-made seeds for formats the shared data lacks (binary and ascii PLY,
 # TGA, BMP, HDR).
 case $target in

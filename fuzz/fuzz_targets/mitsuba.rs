@@ -1,8 +1,6 @@
 //! Mitsuba 3 XML scenes (strict and lenient), then the scene builder on what maps.
 #![no_main]
 
-use std::path::Path;
-
 use candela_scene::LoadOptions;
 use libfuzzer_sys::fuzz_target;
 
@@ -15,8 +13,8 @@ fuzz_target!(|data: &[u8]| {
             lenient: data.len() % 2 == 1,
             ..Default::default()
         };
-        let path = Path::new("/nonexistent/fuzz.xml");
-        match candela_scene::mitsuba::parse_mitsuba(text, path, &options) {
+        let path = candela_fuzz::scene_path("fuzz.xml");
+        match candela_scene::mitsuba::parse_mitsuba(text, &path, &options) {
             Ok(loaded) => {
                 if let Err(e) = candela_core::build::build(&loaded.desc) {
                     candela_fuzz::check_message(&e.to_string());

@@ -1,8 +1,6 @@
 //! Candela's TOML scene format, then the scene builder on what parses.
 #![no_main]
 
-use std::path::Path;
-
 use libfuzzer_sys::fuzz_target;
 
 fuzz_target!(|data: &[u8]| {
@@ -10,7 +8,7 @@ fuzz_target!(|data: &[u8]| {
         let Ok(text) = std::str::from_utf8(data) else {
             return;
         };
-        match candela_scene::parse_toml_scene(text, Path::new("/nonexistent/fuzz.toml")) {
+        match candela_scene::parse_toml_scene(text, &candela_fuzz::scene_path("fuzz.toml")) {
             Ok(desc) => {
                 if let Err(e) = candela_core::build::build(&desc) {
                     candela_fuzz::check_message(&e.to_string());

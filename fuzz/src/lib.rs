@@ -78,3 +78,13 @@ pub fn check_message(message: &str) {
     );
     assert!(!message.is_empty(), "empty error message");
 }
+
+/// Where a scene target's input sits: a file (never read) in the repository's `scenes/`,
+/// so that what an input names relative to it is there to load — the media example's
+/// grid `media/smoke.vol`, the Cornell meshes — and the loaders behind the scene
+/// formats (`.vol` grids, meshes) run on real data too.
+pub fn scene_path(name: &str) -> std::path::PathBuf {
+    std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../scenes")
+        .join(name)
+}

@@ -45,8 +45,8 @@ fn homogeneous(sigma_t: Vec3, albedo: Vec3, phase: PhaseDesc) -> MediumDesc {
     }
 }
 
-/// A scene of one shape of `bsdf` holding medium `m` inside, under `env` (constant
-/// radiance) and `lights`, rendering up to `max_depth` bounces.
+/// The description of a scene of one shape of `bsdf` holding medium `m` inside, under
+/// `env` (constant radiance) and `lights`, rendering up to `max_depth` bounces.
 fn bounded(
     shape: ShapeDesc,
     bsdf: BsdfDesc,
@@ -54,8 +54,8 @@ fn bounded(
     env: Option<Vec3>,
     lights: Vec<LightDesc>,
     max_depth: u32,
-) -> Scene {
-    let desc = SceneDesc {
+) -> SceneDesc {
+    SceneDesc {
         materials: vec![material(&shape.material, bsdf)],
         shapes: vec![shape],
         lights,
@@ -78,7 +78,11 @@ fn bounded(
             ..Default::default()
         },
         ..Default::default()
-    };
+    }
+}
+
+/// The scene `desc` describes.
+fn built(desc: SceneDesc) -> Scene {
     candela_core::build::build(&desc).expect("scene builds")
 }
 
@@ -127,14 +131,14 @@ fn slab_transmittance_is_exponential_in_each_channel() {
     let expected = (-sigma_t.as_dvec3() * 0.5).exp() * 2.0;
     for albedo in [Vec3::ZERO, Vec3::new(0.9, 0.5, 1.0)] {
         let m = homogeneous(sigma_t, albedo, PhaseDesc::Isotropic);
-        let scene = bounded(
+        let scene = built(bounded(
             cube(slab, "b"),
             null(),
             m,
             Some(Vec3::splat(2.0)),
             vec![],
             0,
-        );
+        ));
         let e = estimate(&scene, ray, 200_000, 1);
         assert_close(&format!("slab, albedo {albedo}"), e, expected);
     }
@@ -167,14 +171,14 @@ fn albedo_one_media_in_a_white_furnace_return_the_background() {
     ];
     for (i, (bsdf, phase, sigma_t)) in cases.into_iter().enumerate() {
         let m = homogeneous(sigma_t, Vec3::ONE, phase);
-        let scene = bounded(
+        let scene = built(bounded(
             cube(Mat4::IDENTITY, "b"),
             bsdf,
             m,
             Some(Vec3::ONE),
             vec![],
             1000,
-        );
+        ));
         let ray = Ray::new(
             Vec3::new(0.3, -0.2, 4.0),
             Vec3::new(-0.05, 0.03, -1.0).normalize(),
@@ -211,7 +215,7 @@ fn single_scattering_in_a_thin_slab_matches_its_integral() {
     };
     let m = homogeneous(sigma_t, albedo, PhaseDesc::HenyeyGreenstein { g });
     let slab = Mat4::from_scale(Vec3::new(10.0, 10.0, 0.1));
-    let scene = bounded(cube(slab, "b"), null(), m, None, vec![light], 1);
+    let scene = built(bounded(cube(slab, "b"), null(), m, None, vec![light], 1));
     let ray = Ray::new(Vec3::new(0.0, 0.0, 0.5), -Vec3::Z);
     let expected = DVec3::from_array(std::array::from_fn(|c| {
         let (st, ss) = (sigma_t[c] as f64, (sigma_t[c] * albedo[c]) as f64);
@@ -307,14 +311,14 @@ fn marched_transmittance(scene: &Scene, a: Vec3, b: Vec3, n: usize) -> DVec3 {
 #[test]
 fn grid_transmittance_matches_ray_marching() {
     let m = grid_medium(Vec3::ZERO, 3.0);
-    let scene = bounded(
+    let scene = built(bounded(
         cube(Mat4::IDENTITY, "b"),
         null(),
         m,
         Some(Vec3::ONE),
         vec![],
         0,
-    );
+    ));
     for (i, (o, d)) in [
         (Vec3::new(0.2, -0.3, 3.0), Vec3::new(0.1, 0.2, -1.0)),
         (Vec3::new(-3.0, 0.4, 0.1), Vec3::new(1.0, -0.3, 0.05)),
@@ -335,14 +339,14 @@ fn sparse_grid_tracking_matches_ray_marching_with_either_majorant() {
     // and ratio tracking (the shadow rays of single scattering towards a point light)
     // against ray-marched references, with the coarse majorant grid and with one
     // majorant for the grid: both unbiased, so both within noise of the same values.
-    let absorbing = bounded(
+    let absorbing = built(bounded(
         cube(Mat4::IDENTITY, "b"),
         null(),
         sparse_grid_medium(Vec3::ZERO, 8.0),
         Some(Vec3::ONE),
         vec![],
         0,
-    );
+    ));
     let intensity = 5.0f32;
     let light = LightDesc {
         kind: LightKindDesc::Point {
@@ -351,14 +355,14 @@ fn sparse_grid_tracking_matches_ray_marching_with_either_majorant() {
         },
         span: Span::code(),
     };
-    let scattering = bounded(
+    let scattering = built(bounded(
         cube(Mat4::IDENTITY, "b"),
         null(),
         sparse_grid_medium(Vec3::splat(0.7), 8.0),
         None,
         vec![light],
         1,
-    );
+    ));
     let rays = [
         (Vec3::new(0.3, -0.2, 3.0), Vec3::new(0.0, 0.0, -1.0)),
         (Vec3::new(-3.0, -0.3, 0.2), Vec3::new(1.0, 0.05, -0.02)),
@@ -412,7 +416,14 @@ fn grid_single_scattering_matches_ray_marching() {
         },
         span: Span::code(),
     };
-    let scene = bounded(cube(Mat4::IDENTITY, "b"), null(), m, None, vec![light], 1);
+    let scene = built(bounded(
+        cube(Mat4::IDENTITY, "b"),
+        null(),
+        m,
+        None,
+        vec![light],
+        1,
+    ));
     let (x, y) = (0.1, 0.2);
     let ray = Ray::new(Vec3::new(x, y, 2.0), -Vec3::Z);
     let top = Vec3::new(x, y, 1.0);
@@ -501,58 +512,39 @@ fn lit_medium(m: MediumDesc, mis: MisMode) -> Scene {
     let diffuse = |a: f32| BsdfDesc::Diffuse {
         albedo: TextureDesc::Constant(Vec3::splat(a)),
     };
-    let desc = SceneDesc {
-        materials: vec![
-            material("b", null()),
-            material("floor", diffuse(0.5)),
-            material("lamp", diffuse(0.0)),
-        ],
-        shapes: vec![
-            cube(Mat4::IDENTITY, "b"),
-            rect(
-                Mat4::from_translation(Vec3::new(0.0, -1.5, 0.0))
-                    * Mat4::from_rotation_x(-std::f32::consts::FRAC_PI_2)
-                    * Mat4::from_scale(Vec3::splat(4.0)),
-                "floor",
-                None,
-            ),
-            rect(
-                Mat4::from_translation(Vec3::new(0.3, 2.0, 0.2))
-                    * Mat4::from_rotation_x(std::f32::consts::FRAC_PI_2)
-                    * Mat4::from_scale(Vec3::splat(0.3)),
-                "lamp",
-                Some(Vec3::new(20.0, 16.0, 12.0)),
-            ),
-        ],
-        lights: vec![LightDesc {
-            kind: LightKindDesc::Point {
-                position: Vec3::new(1.5, 1.2, 1.0),
-                intensity: Vec3::splat(2.0),
-            },
-            span: Span::code(),
-        }],
-        environment: Some(EnvironmentDesc {
-            map: EnvironmentMapDesc::Constant(Vec3::splat(0.3)),
-            ..Default::default()
-        }),
-        media: MediaDesc {
-            shapes: vec![ShapeMediaDesc {
-                shape: 0,
-                interior: Some(m.name.clone()),
-                exterior: None,
-                span: Span::code(),
-            }],
-            media: vec![m],
-            ..Default::default()
+    let point = LightDesc {
+        kind: LightKindDesc::Point {
+            position: Vec3::new(1.5, 1.2, 1.0),
+            intensity: Vec3::splat(2.0),
         },
-        render: RenderSettings {
-            max_depth: 5,
-            mis,
-            ..Default::default()
-        },
-        ..Default::default()
+        span: Span::code(),
     };
-    candela_core::build::build(&desc).expect("scene builds")
+    let mut desc = bounded(
+        cube(Mat4::IDENTITY, "b"),
+        null(),
+        m,
+        Some(Vec3::splat(0.3)),
+        vec![point],
+        5,
+    );
+    desc.render.mis = mis;
+    desc.materials.push(material("floor", diffuse(0.5)));
+    desc.materials.push(material("lamp", diffuse(0.0)));
+    desc.shapes.push(rect(
+        Mat4::from_translation(Vec3::new(0.0, -1.5, 0.0))
+            * Mat4::from_rotation_x(-std::f32::consts::FRAC_PI_2)
+            * Mat4::from_scale(Vec3::splat(4.0)),
+        "floor",
+        None,
+    ));
+    desc.shapes.push(rect(
+        Mat4::from_translation(Vec3::new(0.3, 2.0, 0.2))
+            * Mat4::from_rotation_x(std::f32::consts::FRAC_PI_2)
+            * Mat4::from_scale(Vec3::splat(0.3)),
+        "lamp",
+        Some(Vec3::new(20.0, 16.0, 12.0)),
+    ));
+    built(desc)
 }
 
 #[test]

@@ -44,6 +44,7 @@ pub struct MajorantTracker<'a> {
 impl<'a> MajorantTracker<'a> {
     /// Tracking of `ray` (unit direction) through `medium` up to `t_max`, distances drawn
     /// at the majorant of channel `hero` (0..3).
+    #[inline]
     pub fn new(medium: &'a Medium, ray: &Ray, t_max: f32, hero: usize) -> Self {
         let mut segments = medium.majorants(ray, t_max);
         let segment = segments.next();
