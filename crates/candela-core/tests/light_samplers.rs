@@ -280,3 +280,70 @@ fn zero_importance_means_no_contribution() {
     // The check is not vacuous: about half the triangles face away from any point.
     assert!(zeros > 1000, "only {zeros} zero-importance cases");
 }
+
+/// A sun, an even sky and a sky with a bright patch beside the 64 lights: the BVH picks
+/// among the three infinite lights by their importance at the point (the sun's irradiance;
+/// each sky's light above its mean, plus a sixteenth of the whole), its picks follow its
+/// pmf (chi-square at the four points), and every infinite light keeps a positive pmf.
+#[test]
+fn bvh_picks_infinite_lights_by_their_importance() {
+    use candela_core::light::envmap::{Equirect, Image};
+    use candela_core::light::{DirectionalLight, EnvironmentLight, EnvironmentMap};
+    use glam::Mat3;
+
+    let mut lights = lights();
+    let sun = lights.len() as u32;
+    lights.push(Light::Directional(DirectionalLight {
+        direction: Vec3::new(-0.4, -0.8, -0.45).normalize(),
+        irradiance: Vec3::new(4.0, 3.6, 3.0),
+        scene_radius: 10.0,
+    }));
+    let even = lights.len() as u32;
+    let sky = |map| EnvironmentLight::new(map, 1.0, Mat3::IDENTITY, 10.0);
+    lights.push(Light::Environment(sky(EnvironmentMap::Constant(
+        Vec3::new(0.3, 0.45, 0.8),
+    ))));
+    let patchy = lights.len() as u32;
+    let mut pixels = vec![Vec3::splat(0.2); 32 * 16];
+    pixels[3 * 32 + 20] = Vec3::splat(500.0);
+    lights.push(Light::Environment(sky(EnvironmentMap::Equirect(
+        Equirect::new(Image {
+            width: 32,
+            height: 16,
+            pixels,
+        }),
+    ))));
+    let sampler = LightSampler::new(LightSamplerKind::Bvh, 8, &lights);
+    let alpha = sidak_alpha(0.01, contexts().len());
+    for (ci, ctx) in contexts().iter().enumerate() {
+        let pmf: Vec<f64> = (0..lights.len() as u32)
+            .map(|i| sampler.pmf(ctx, LightId(i)) as f64)
+            .collect();
+        for i in [sun, even, patchy] {
+            assert!(
+                pmf[i as usize] > 0.0,
+                "infinite light {i} refused at ctx {ci}"
+            );
+        }
+        let mut counts = vec![0u64; lights.len()];
+        let mut rng = Pcg32::new(29, ci as u64);
+        for _ in 0..SAMPLES {
+            let pick = sampler.sample(ctx, rng.uniform_f32(), &lights).unwrap();
+            assert!((pick.pmf as f64 / pmf[pick.id.0 as usize] - 1.0).abs() < 1e-4);
+            counts[pick.id.0 as usize] += 1;
+        }
+        discrete(&format!("infinite at ctx {ci}"), &counts, &pmf, alpha).assert_passed();
+    }
+    // Facing the sun (n = y): E·cos θ ≈ 2.9 against π·0.43/16 ≈ 0.08 for the even sky.
+    let up = contexts()[0];
+    let p = |i: u32| sampler.pmf(&up, LightId(i));
+    assert!(p(sun) > 20.0 * p(even), "sun {} sky {}", p(sun), p(even));
+    // The patch (500 over 0.024 sr, 37° from the zenith: ≈ 9 on this surface) outweighs
+    // the sun's 2.9.
+    assert!(
+        p(patchy) > p(sun),
+        "patchy sky {} sun {}",
+        p(patchy),
+        p(sun)
+    );
+}

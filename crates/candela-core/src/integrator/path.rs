@@ -82,8 +82,22 @@ pub(super) fn li_isa<S: Sampler, const V3: bool>(
             break;
         }
         let Some(si) = hit.as_ref() else {
-            for (id, le) in super::sky::escaped(scene, &ray, depth == 0) {
-                l += beta * le * emitter_weight(specular, &prev_ctx, prev_bsdf_pdf, id, ray.d);
+            for &id in &scene.infinite_lights {
+                let light = scene.light(id);
+                let (le, weight) = if depth == 0 {
+                    (light.le_camera(&ray), 1.0)
+                } else if !specular && matches!(mode, MisMode::Balance | MisMode::Power) {
+                    // The radiance and the density MIS weighs it by, from one lookup.
+                    let (le, pdf) = light.le_pdf(&prev_ctx, &ray);
+                    let light_pdf = scene.light_sampler.pmf(&prev_ctx, id) * pdf;
+                    (le, mis_weight(mode, prev_bsdf_pdf, light_pdf))
+                } else {
+                    let weight = emitter_weight(specular, &prev_ctx, prev_bsdf_pdf, id, ray.d);
+                    (light.le(&ray), weight)
+                };
+                if le != Vec3::ZERO {
+                    l += beta * le * weight;
+                }
             }
             break;
         };

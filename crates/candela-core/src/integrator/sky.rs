@@ -1,5 +1,6 @@
-//! Radiance from the lights at infinity along a ray that leaves the scene, shared by the
-//! path tracer and the volumetric one (each weights it by its own MIS).
+//! Radiance from the lights at infinity along a ray that leaves the scene, for the
+//! volumetric path tracer (which weights it by its own MIS). The surface path tracer
+//! (`path.rs`) looks up the radiance and its MIS density together (`Light::le_pdf`).
 
 use glam::Vec3;
 

@@ -2,7 +2,7 @@ use std::f32::consts::PI;
 
 use glam::{Vec2, Vec3};
 
-use super::{receiver_cos, LightBounds, LightFlags, LightSample, LightSource, ShadingCtx};
+use super::{InfiniteImportance, LightBounds, LightFlags, LightSample, LightSource, ShadingCtx};
 use crate::math::luminance;
 
 /// Parallel light from infinitely far away, travelling along `direction`: a surface facing
@@ -35,9 +35,13 @@ impl LightSource for DirectionalLight {
         })
     }
 
-    /// E × the receiver cosine towards the light.
+    /// E × the receiver cosine towards the light (see [`InfiniteImportance`]).
     fn importance(&self, ctx: &ShadingCtx) -> f32 {
-        luminance(self.irradiance) * receiver_cos(ctx, -self.direction)
+        InfiniteImportance::Direction {
+            irradiance: luminance(self.irradiance),
+            wi: -self.direction,
+        }
+        .at(ctx)
     }
 
     /// The power crossing the scene's bounding disk, Φ = π r² E (pbrt-v4 §12.4).

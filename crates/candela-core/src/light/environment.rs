@@ -7,8 +7,8 @@ use std::f32::consts::PI;
 
 use glam::{Mat3, Vec2, Vec3};
 
-use super::envmap::{Cubemap, Equirect};
-use super::{LightBounds, LightFlags, LightSample, LightSource, ShadingCtx};
+use super::envmap::{Cubemap, Equirect, MapSample};
+use super::{LightBounds, LightFlags, LightSample, LightSource, ShadingCtx, SkyImportance};
 use crate::geometry::Ray;
 use crate::math::luminance;
 use crate::sampling::sample_uniform_sphere;
@@ -45,6 +45,9 @@ pub struct EnvironmentLight {
     pub scene_radius: f32,
     /// ∫ luminance(L) dω over the sphere, strength included.
     pub luminance_integral: f32,
+    /// Worth to light sampling by surface normal (world frame, strength included), for
+    /// choosing among infinite lights; boxed, to keep [`super::Light`] small.
+    pub importance: Box<SkyImportance>,
 }
 
 impl EnvironmentLight {
@@ -59,7 +62,13 @@ impl EnvironmentLight {
             EnvironmentMap::Equirect(m) => m.luminance_integral(),
             EnvironmentMap::Cubemap(m) => m.luminance_integral(),
         };
+        let importance = match &map {
+            EnvironmentMap::Constant(c) => SkyImportance::constant(luminance(*c)),
+            EnvironmentMap::Equirect(m) => SkyImportance::from_patches(m.luminance_patches()),
+            EnvironmentMap::Cubemap(m) => SkyImportance::from_patches(m.luminance_patches()),
+        };
         EnvironmentLight {
+            importance: Box::new(importance.rotated_scaled(world_from_map, strength)),
             map,
             strength,
             world_from_map,
@@ -74,13 +83,16 @@ impl EnvironmentLight {
 
     /// Radiance arriving along `-d` from direction `d` (world space, unit).
     pub fn eval(&self, d: Vec3) -> Vec3 {
-        let local = self.map_from_world * d;
-        self.strength
-            * match &self.map {
-                EnvironmentMap::Constant(c) => *c,
-                EnvironmentMap::Equirect(m) => m.eval(local),
-                EnvironmentMap::Cubemap(m) => m.eval(local),
-            }
+        self.strength * self.eval_local(self.map_from_world * d)
+    }
+
+    /// The map's radiance towards `local` (the map's frame, unit), strength not applied.
+    fn eval_local(&self, local: Vec3) -> Vec3 {
+        match &self.map {
+            EnvironmentMap::Constant(c) => *c,
+            EnvironmentMap::Equirect(m) => m.eval(local),
+            EnvironmentMap::Cubemap(m) => m.eval(local),
+        }
     }
 
     /// What a camera ray that escapes sees: the map, or the background when hidden.
@@ -138,20 +150,37 @@ impl LightSource for EnvironmentLight {
         self.eval(ray.d.normalize())
     }
 
+    /// The equirect map's radiance and density from one lookup of its grid.
+    fn le_pdf(&self, ctx: &ShadingCtx, ray: &Ray) -> (Vec3, f32) {
+        match (&self.map, self.sampling) {
+            (EnvironmentMap::Equirect(m), EnvironmentSampling::Importance) => {
+                let (l, pdf) = m.eval_pdf(self.map_from_world * ray.d.normalize());
+                (self.strength * l, pdf)
+            }
+            _ => (self.le(ray), self.pdf_li(ctx, ray.d)),
+        }
+    }
+
     fn sample_li(&self, _ctx: &ShadingCtx, u: Vec2) -> Option<LightSample> {
-        let (local, pdf) = match (&self.map, self.sampling) {
-            (EnvironmentMap::Constant(_), _) | (_, EnvironmentSampling::Uniform) => {
-                (sample_uniform_sphere(u), 1.0 / (4.0 * PI))
+        let s = match (&self.map, self.sampling) {
+            (_, EnvironmentSampling::Uniform) | (EnvironmentMap::Constant(_), _) => {
+                let dir = sample_uniform_sphere(u);
+                let radiance = self.eval_local(dir);
+                MapSample {
+                    dir,
+                    pdf: 1.0 / (4.0 * PI),
+                    radiance,
+                }
             }
             (EnvironmentMap::Equirect(m), _) => m.sample(u)?,
             (EnvironmentMap::Cubemap(m), _) => m.sample(u)?,
         };
-        let wi = (self.world_from_map * local).normalize();
+        let wi = (self.world_from_map * s.dir).normalize();
         Some(LightSample {
-            radiance: self.eval(wi),
+            radiance: self.strength * s.radiance,
             wi,
             distance: f32::INFINITY,
-            pdf,
+            pdf: s.pdf,
             is_delta: false,
             p_light: wi,
             n_light: Vec3::ZERO,
@@ -176,11 +205,11 @@ impl LightSource for EnvironmentLight {
         PI * self.scene_radius * self.scene_radius * self.luminance_integral
     }
 
-    /// Potential contribution at any point, for light selection: ∫ L dω over the sphere
-    /// (solid angle × brightness, with the receiver cosine bounded by 1), as for the
-    /// other lights' `importance`.
-    fn importance(&self, _ctx: &ShadingCtx) -> f32 {
-        self.luminance_integral
+    /// Worth to light sampling at `ctx`, for light selection: the irradiance of the
+    /// radiance above the sky's mean, plus a sixteenth of the whole (see
+    /// [`SkyImportance`]).
+    fn importance(&self, ctx: &ShadingCtx) -> f32 {
+        self.importance.at(ctx)
     }
 
     /// Infinite: the BVH sampler picks it apart from the tree.

@@ -21,6 +21,7 @@ mod emission_texture;
 mod environment;
 pub mod envmap;
 mod goniometric;
+mod infinite_importance;
 mod parallelogram;
 mod point;
 mod positional;
@@ -37,6 +38,7 @@ pub use directional::DirectionalLight;
 pub use emission_texture::EmissionTexture;
 pub use environment::{EnvironmentLight, EnvironmentMap, EnvironmentSampling};
 pub use goniometric::GoniometricLight;
+pub use infinite_importance::{InfiniteImportance, SkyImportance, SkyIrradiance};
 pub use parallelogram::ParallelogramLight;
 pub use point::PointLight;
 pub use profile::LightProfile;
@@ -229,6 +231,13 @@ impl Light {
         dispatch!(self, l => l.le(ray))
     }
 
+    /// [`Self::le`] along `ray` and [`Self::pdf_li`] of its direction at `ctx`, from
+    /// one lookup where the light can (the same values as the two calls).
+    #[inline]
+    pub fn le_pdf(&self, ctx: &ShadingCtx, ray: &Ray) -> (Vec3, f32) {
+        dispatch!(self, l => l.le_pdf(ctx, ray))
+    }
+
     /// What an escaped camera ray sees of an infinite light: [`Self::le`], unless the
     /// light is hidden from the camera.
     pub fn le_camera(&self, ray: &Ray) -> Vec3 {
@@ -250,6 +259,19 @@ impl Light {
     /// cosine is taken in absolute value so that transmitting BSDFs are not cut off.
     pub fn importance(&self, ctx: &ShadingCtx) -> f32 {
         dispatch!(self, l => l.importance(ctx))
+    }
+
+    /// What the light BVH keeps to weigh an infinite light at a shading point (its
+    /// [`Self::importance`] without the light); `None` for the lights with bounds.
+    pub fn infinite_importance(&self) -> Option<InfiniteImportance> {
+        match self {
+            Light::Directional(l) => Some(InfiniteImportance::Direction {
+                irradiance: luminance(l.irradiance),
+                wi: -l.direction,
+            }),
+            Light::Environment(l) => Some(InfiniteImportance::Sky(*l.importance)),
+            _ => None,
+        }
     }
 
     /// Bounds for the light BVH; `None` for lights that are not bounded in space (infinite

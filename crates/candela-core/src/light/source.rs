@@ -63,6 +63,12 @@ pub trait LightSource {
         Vec3::ZERO
     }
 
+    /// [`Self::le`] along `ray` and [`Self::pdf_li`] of its direction at `ctx`, as MIS
+    /// weighs an escaped ray: lights whose lookup serves both answer from one.
+    fn le_pdf(&self, ctx: &ShadingCtx, ray: &Ray) -> (Vec3, f32) {
+        (self.le(ray), self.pdf_li(ctx, ray.d))
+    }
+
     /// Total emitted power Φ, as a luminance-weighted scalar (W).
     fn power(&self) -> f32;
 

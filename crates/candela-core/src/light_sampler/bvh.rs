@@ -4,12 +4,16 @@
 //! O(log N). The pick probability is the product of the choices along the way, which
 //! [`LightBvh::pmf`] retraces from a per-light bit trail.
 //!
-//! Lights without bounds (infinite lights) are kept apart and picked uniformly with
-//! probability n_inf / (n_inf + 1), the tree counting as one more "light" (as pbrt does).
+//! Lights without bounds (infinite lights) are kept apart and picked with probability
+//! n_inf / (n_inf + 1), the tree counting as one more "light" (as pbrt does); among
+//! themselves by their importance at the point ([`InfiniteImportance`]: a sun is picked
+//! over a sky where it gives more light), where pbrt picks them uniformly.
 
 use rayon::join;
 
-use crate::light::{cone_measure, ImportanceBounds, Light, LightBounds, ShadingCtx};
+use crate::light::{
+    cone_measure, ImportanceBounds, InfiniteImportance, Light, LightBounds, ShadingCtx,
+};
 use crate::sampling::ONE_MINUS_EPSILON;
 
 /// Buckets per split candidate of the build.
@@ -44,6 +48,9 @@ struct FlatNode {
 pub struct LightBvh {
     nodes: Vec<FlatNode>,
     infinite: Vec<u32>,
+    /// Per infinite light, what weighs it at a point; empty where some infinite light
+    /// has no such measure (then they are picked uniformly).
+    infinite_importance: Vec<InfiniteImportance>,
     /// Per light: the branch taken at each level (bit d = level d, 1 = second child),
     /// with a leading 1 marking the depth; 0 where the light is not in the tree.
     trails: Vec<u64>,
@@ -75,9 +82,15 @@ impl LightBvh {
         if items.is_empty() && infinite.is_empty() {
             return None;
         }
+        let infinite_importance = infinite
+            .iter()
+            .map(|&i| lights[i as usize].infinite_importance())
+            .collect::<Option<Vec<_>>>()
+            .unwrap_or_default();
         let mut bvh = LightBvh {
             nodes: Vec::with_capacity(2 * items.len()),
             infinite,
+            infinite_importance,
             trails: vec![0; lights.len()],
         };
         if !items.is_empty() {
@@ -137,9 +150,8 @@ impl LightBvh {
         let p_tree = self.p_tree();
         let p_inf = 1.0 - p_tree;
         if u < p_inf {
-            let n = self.infinite.len();
-            let i = ((u / p_inf * n as f32) as usize).min(n - 1);
-            return Some((self.infinite[i], p_inf / n as f32));
+            let (i, p) = self.pick_infinite(ctx, (u / p_inf).min(ONE_MINUS_EPSILON));
+            return Some((self.infinite[i], p_inf * p));
         }
         u = ((u - p_inf) / p_tree).min(ONE_MINUS_EPSILON);
         let mut pmf = p_tree;
@@ -173,9 +185,9 @@ impl LightBvh {
     pub fn pmf(&self, ctx: &ShadingCtx, light: u32) -> f32 {
         let trail = self.trails[light as usize];
         if trail == 0 {
-            return match self.infinite.contains(&light) {
-                true => (1.0 - self.p_tree()) / self.infinite.len() as f32,
-                false => 0.0,
+            return match self.infinite.iter().position(|&l| l == light) {
+                Some(i) => (1.0 - self.p_tree()) * self.infinite_pmf(ctx, i),
+                None => 0.0,
             };
         }
         let depth = 63 - trail.leading_zeros();
@@ -202,6 +214,52 @@ impl LightBvh {
             return 0.0;
         }
         pmf
+    }
+
+    /// The importances of the infinite lights at `ctx` and their sum, or `None` where
+    /// they are to be picked uniformly (one light, no measure, or nothing positive).
+    #[inline]
+    fn infinite_weights(&self, ctx: &ShadingCtx) -> Option<(impl Iterator<Item = f32> + '_, f32)> {
+        if self.infinite.len() < 2 || self.infinite_importance.is_empty() {
+            return None;
+        }
+        let ctx = *ctx;
+        let weights = self
+            .infinite_importance
+            .iter()
+            .map(move |m| m.at(&ctx).max(0.0));
+        let total: f32 = weights.clone().sum();
+        (total > 0.0 && total.is_finite()).then_some((weights, total))
+    }
+
+    /// One of the infinite lights (its index in `infinite`) and its probability among
+    /// them, from `u ∈ [0, 1)`.
+    fn pick_infinite(&self, ctx: &ShadingCtx, u: f32) -> (usize, f32) {
+        let n = self.infinite.len();
+        let Some((weights, total)) = self.infinite_weights(ctx) else {
+            return (((u * n as f32) as usize).min(n - 1), 1.0 / n as f32);
+        };
+        let target = u * total;
+        let mut acc = 0.0;
+        let mut last = (0, 0.0);
+        for (i, w) in weights.enumerate() {
+            if w > 0.0 {
+                last = (i, w / total);
+                acc += w;
+                if target < acc {
+                    break;
+                }
+            }
+        }
+        last
+    }
+
+    /// Probability that [`Self::pick_infinite`] picks infinite light `i` at `ctx`.
+    fn infinite_pmf(&self, ctx: &ShadingCtx, i: usize) -> f32 {
+        match self.infinite_weights(ctx) {
+            Some((mut weights, total)) => weights.nth(i).unwrap_or(0.0) / total,
+            None => 1.0 / self.infinite.len() as f32,
+        }
     }
 
     /// Bytes held, for the benchmark's memory note.

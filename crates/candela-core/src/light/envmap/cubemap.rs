@@ -24,7 +24,7 @@
 
 use glam::{Vec2, Vec3};
 
-use super::{Distribution2D, Image};
+use super::{Distribution2D, Image, MapSample};
 use crate::math::luminance;
 use crate::sampling::Distribution1D;
 
@@ -106,13 +106,17 @@ impl Cubemap {
     }
 
     /// A direction drawn in proportion to the importance, with its solid-angle density.
-    pub fn sample(&self, u: Vec2) -> Option<(Vec3, f32)> {
+    pub fn sample(&self, u: Vec2) -> Option<MapSample> {
         let (x, pdf_face, face) = self.face_distribution.sample_continuous(u.x);
         // Reuse the remainder of u.x within the chosen face's cell.
         let ux = (x * 6.0 - face as f32).clamp(0.0, crate::sampling::ONE_MINUS_EPSILON);
         let (st, pdf_st) = self.distributions[face].sample(Vec2::new(ux, u.y));
         let pdf = pdf_face / 6.0 * pdf_st / solid_angle_jacobian(st);
-        (pdf > 0.0).then(|| (face_to_direction(face, st), pdf))
+        (pdf > 0.0).then(|| MapSample {
+            dir: face_to_direction(face, st),
+            pdf,
+            radiance: self.faces[face].bilinear(st, false),
+        })
     }
 
     /// Solid-angle density of [`Self::sample`] towards direction `d`.
@@ -120,6 +124,21 @@ impl Cubemap {
         let (f, st) = direction_to_face(d);
         let pmf = self.face_distribution.pdf((f as f32 + 0.5) / 6.0) / 6.0;
         pmf * self.distributions[f].pdf(st) / solid_angle_jacobian(st)
+    }
+
+    /// Each texel's direction (its centre), luminance × solid angle, and solid angle.
+    pub fn luminance_patches(&self) -> impl Iterator<Item = (Vec3, f32, f32)> + Clone + '_ {
+        self.faces.iter().enumerate().flat_map(|(f, img)| {
+            let n = img.width;
+            img.pixels.iter().enumerate().map(move |(i, &l)| {
+                let st = Vec2::new(
+                    ((i % n) as f32 + 0.5) / n as f32,
+                    ((i / n) as f32 + 0.5) / n as f32,
+                );
+                let area = solid_angle_jacobian(st) / (n * n) as f32;
+                (face_to_direction(f, st), luminance(l).max(0.0) * area, area)
+            })
+        })
     }
 
     /// ∫ luminance(L) dω, by the midpoint rule over half-texels of the bilinear faces.

@@ -9,12 +9,14 @@
 //! - [`Cubemap`]: six square faces in the order +x, −x, +y, −y, +z, −z, with the OpenGL /
 //!   Direct3D face table (see [`cubemap`]).
 //!
-//! Both are sampled through a piecewise-constant 2D distribution on a grid of half-texels
-//! (2W × 2H cells): over each half-texel cell the bilinear lookup blends exactly one 2×2
-//! neighbourhood of texels, and the cell's weight is the maximum of those four texels. So
-//! the density is positive wherever the filtered radiance is (pbrt-v4 §12.5.2 makes the
-//! same point with its compensated distributions).
+//! [`Equirect`] samples a bilinear density through the texel centres, so that the
+//! density follows the filtered radiance within every texel ([`bilinear`], as Mitsuba 3's
+//! `envmap`). [`Cubemap`] samples a piecewise-constant 2D distribution on a grid of
+//! half-texels (2W × 2H cells): over each half-texel cell the bilinear lookup blends
+//! exactly one 2×2 neighbourhood of texels, and the cell's weight is the maximum of those
+//! four texels. Either way the density is positive wherever the filtered radiance is.
 
+pub mod bilinear;
 pub mod cubemap;
 pub mod equirect;
 
@@ -26,6 +28,15 @@ use glam::{Vec2, Vec3};
 use crate::desc::ImageDesc;
 use crate::math::luminance;
 use crate::sampling::{Distribution1D, ONE_MINUS_EPSILON};
+
+/// A direction drawn from an environment map: its solid-angle density and the radiance
+/// arriving along it (in the map's frame, strength not applied).
+#[derive(Clone, Copy, Debug)]
+pub struct MapSample {
+    pub dir: Vec3,
+    pub pdf: f32,
+    pub radiance: Vec3,
+}
 
 /// A linear RGB image, row-major, top row first.
 #[derive(Clone, Debug)]
