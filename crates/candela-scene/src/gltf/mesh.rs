@@ -248,22 +248,42 @@ fn read_primitive(
             return Err(ctx.error(path, format!("{what} has {len} elements for {n} positions")));
         }
     }
-    let order: Vec<u32> = match prim.indices() {
-        None => (0..n as u32).collect(),
-        Some(a) => match reader.read_indices() {
-            Some(it) => it.into_u32().collect(),
+    let indices = match (mode, prim.indices()) {
+        // Straight into triangles, without the list of indices beside them.
+        (Mode::Triangles, Some(a)) => match reader.read_indices() {
+            Some(it) => {
+                let mut tris = Vec::with_capacity(a.count() / 3);
+                let (mut corners, mut k) = ([0; 3], 0);
+                for i in it.into_u32() {
+                    check_indices(ctx, path, [&i], n)?;
+                    corners[k] = i;
+                    k += 1;
+                    if k == 3 {
+                        tris.push(corners);
+                        k = 0;
+                    }
+                }
+                tris
+            }
             None => return Err(unreadable(ctx, path, "indices", &a)),
         },
+        (_, indices) => {
+            let order: Vec<u32> = match indices {
+                None => (0..n as u32).collect(),
+                Some(a) => match reader.read_indices() {
+                    Some(it) => it.into_u32().collect(),
+                    None => return Err(unreadable(ctx, path, "indices", &a)),
+                },
+            };
+            check_indices(ctx, path, &order, n)?;
+            triangulate(mode, &order)
+        }
     };
-    if let Some(&i) = order.iter().find(|&&i| i as usize >= n) {
-        return Err(ctx.error(path, format!("index {i} is out of range ({n} vertices)")));
-    }
     if translucent {
         ctx.warn(format!(
             "{path}: the alpha of COLOR_0 is ignored (only its RGB multiplies the base colour)"
         ));
     }
-    let indices = triangulate(mode, &order);
     if indices.is_empty() {
         ctx.warn(format!("{path}: has no triangles and is skipped"));
         return Ok(None);
@@ -286,6 +306,19 @@ fn read_primitive(
         colors,
         tangents,
     }))
+}
+
+/// An error where an index is `n` or more.
+fn check_indices<'a>(
+    ctx: &Ctx,
+    path: &str,
+    indices: impl IntoIterator<Item = &'a u32>,
+    n: usize,
+) -> Result<(), LoadError> {
+    match indices.into_iter().find(|&&i| i as usize >= n) {
+        Some(i) => Err(ctx.error(path, format!("index {i} is out of range ({n} vertices)"))),
+        None => Ok(()),
+    }
 }
 
 /// Triangles of a primitive from its vertex order (glTF 2.0 §3.7.2.1).

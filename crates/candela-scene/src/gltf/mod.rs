@@ -15,6 +15,7 @@
 //! Errors are located: JSON syntax errors by `file:line:col`, semantic ones by the JSON
 //! path (`file: meshes[2].primitives[0]: …`). [`parse_gltf`] works on bytes in memory.
 
+use std::borrow::Cow;
 use std::collections::HashSet;
 use std::path::Path;
 
@@ -207,16 +208,19 @@ fn read_document(name: &str, bytes: &[u8]) -> Result<gltf::Gltf, LoadError> {
 
 /// Parses a glTF or GLB file held in memory into the shapes, materials, lights and
 /// camera of one of its scenes (`options.scene`, else the default, else the first).
-/// External files resolve against `base`; `file` names the source in messages.
+/// External files resolve against `base`; `file` names the source in messages. Bytes
+/// given owned are freed once the document and its binary chunk are read from them,
+/// before the meshes are.
 pub fn parse_gltf_scene(
-    bytes: &[u8],
+    bytes: Cow<'_, [u8]>,
     file: &Path,
     base: Option<&Path>,
     options: &LoadOptions,
     prefix: &str,
 ) -> Result<GltfScene, LoadError> {
     let name = file.display().to_string();
-    let gltf::Gltf { document, blob } = read_document(&name, bytes)?;
+    let gltf::Gltf { document, blob } = read_document(&name, &bytes)?;
+    drop(bytes);
     check_required_extensions(&name, document.extensions_required())?;
     let mut warnings = Vec::new();
     for ext in document.extensions_used() {
@@ -312,7 +316,12 @@ pub fn parse_gltf(
     base: Option<&Path>,
     options: &LoadOptions,
 ) -> Result<LoadedScene, LoadError> {
-    let g = parse_gltf_scene(bytes, file, base, options, "")?;
+    let g = parse_gltf_scene(Cow::Borrowed(bytes), file, base, options, "")?;
+    Ok(whole_scene(g, file))
+}
+
+/// A glTF scene as a whole scene (see [`parse_gltf`]).
+fn whole_scene(g: GltfScene, file: &Path) -> LoadedScene {
     let mut desc = SceneDesc {
         shapes: g.shapes,
         materials: g.materials,
@@ -331,7 +340,7 @@ pub fn parse_gltf(
         None => desc.camera = camera::framing_camera(&desc.shapes, desc.camera.fov_y_deg),
     }
     light_if_unlit(&mut desc, file, &mut warnings);
-    Ok(LoadedScene { desc, warnings })
+    LoadedScene { desc, warnings }
 }
 
 /// Gives a scene without lights or emitting shapes (a model file of `file`) a uniform
@@ -359,10 +368,7 @@ pub fn load_gltf(path: &Path, options: &LoadOptions) -> Result<LoadedScene, Load
             format!("cannot read glTF file: {e}"),
         )
     })?;
-    parse_gltf(
-        &bytes,
-        path,
-        Some(path.parent().unwrap_or(Path::new("."))),
-        options,
-    )
+    let base = Some(path.parent().unwrap_or(Path::new(".")));
+    let g = parse_gltf_scene(Cow::Owned(bytes), path, base, options, "")?;
+    Ok(whole_scene(g, path))
 }

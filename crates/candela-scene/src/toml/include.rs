@@ -64,7 +64,7 @@ pub(crate) fn parse_include(
         ..LoadOptions::default()
     };
     let g = parse_gltf_scene(
-        &bytes,
+        bytes.into(),
         &path,
         Some(path.parent().unwrap_or(Path::new(""))),
         &options,
