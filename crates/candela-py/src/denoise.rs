@@ -11,15 +11,13 @@ use std::sync::atomic::AtomicBool;
 use std::sync::{Arc, Mutex};
 
 use candela_core::aov::AovKind;
-
 use candela_denoise::{Denoiser, Guides, Images, Options};
-use glam::Vec3;
 use pyo3::create_exception;
 use pyo3::exceptions::{PyRuntimeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::{PyBytes, PyDict};
 
-use crate::{pixel_bytes, Scene, SceneError};
+use crate::{pixel_bytes, rgb_pixels, Scene, SceneError};
 
 create_exception!(
     _candela,
@@ -42,24 +40,6 @@ fn denoiser(pyoidn: Option<PathBuf>) -> PyResult<Arc<Denoiser>> {
     Ok(d)
 }
 
-/// Little-endian float32 RGB bytes as pixels; `what` names the image in the error.
-fn pixels(bytes: &[u8], n: usize, what: &str) -> PyResult<Vec<Vec3>> {
-    if bytes.len() != 12 * n {
-        return Err(PyValueError::new_err(format!(
-            "{what}: expected {n} RGB float32 pixels ({} bytes), got {} bytes",
-            12 * n,
-            bytes.len()
-        )));
-    }
-    Ok(bytes
-        .chunks_exact(12)
-        .map(|p| {
-            let f = |i: usize| f32::from_le_bytes(p[4 * i..4 * i + 4].try_into().unwrap());
-            Vec3::new(f(0), f(1), f(2))
-        })
-        .collect())
-}
-
 /// Denoises `color` (width·height float32 RGB pixels, row-major) with OIDN's `RT` filter,
 /// guided by `albedo` and `normal` if given; returns the denoised pixels as bytes.
 /// `pyoidn`: the package folder of `pyoidn` to load the library from after `OIDN_DIR`.
@@ -80,9 +60,9 @@ pub fn denoise<'py>(
     pyoidn: Option<PathBuf>,
 ) -> PyResult<Bound<'py, PyBytes>> {
     let n = width as usize * height as usize;
-    let color = pixels(color, n, "img")?;
-    let albedo = albedo.map(|a| pixels(a, n, "albedo")).transpose()?;
-    let normal = normal.map(|a| pixels(a, n, "normal")).transpose()?;
+    let color = rgb_pixels(color, n, "img")?;
+    let albedo = albedo.map(|a| rgb_pixels(a, n, "albedo")).transpose()?;
+    let normal = normal.map(|a| rgb_pixels(a, n, "normal")).transpose()?;
     if normal.is_some() && albedo.is_none() {
         return Err(PyValueError::new_err(
             "normal needs albedo too (Open Image Denoise takes a normal pass only beside an albedo pass)",

@@ -206,12 +206,32 @@ impl Film {
     }
 }
 
+/// Pixels as little-endian float32 RGB bytes, how images cross into Python.
 fn pixel_bytes(pixels: &[Vec3]) -> Vec<u8> {
     pixels
         .iter()
         .flat_map(|p| p.to_array())
         .flat_map(f32::to_le_bytes)
         .collect()
+}
+
+/// [`pixel_bytes`] back into `n` pixels, or an error naming the image (`what`) when the
+/// length is not 12·`n` bytes.
+fn rgb_pixels(bytes: &[u8], n: usize, what: &str) -> PyResult<Vec<Vec3>> {
+    if bytes.len() != 12 * n {
+        return Err(PyValueError::new_err(format!(
+            "{what}: expected {n} RGB float32 pixels ({} bytes), got {} bytes",
+            12 * n,
+            bytes.len()
+        )));
+    }
+    Ok(bytes
+        .chunks_exact(12)
+        .map(|p| {
+            let f = |i: usize| f32::from_le_bytes(p[4 * i..4 * i + 4].try_into().unwrap());
+            Vec3::new(f(0), f(1), f(2))
+        })
+        .collect())
 }
 
 /// Loads a scene (.toml, Mitsuba .xml, .gltf/.glb) with `NAME=VALUE` parameters.
@@ -378,21 +398,11 @@ fn write_pixels(
     gamma: Option<f32>,
 ) -> PyResult<()> {
     let n = width as usize * height as usize;
-    if pixels.len() != n * 12 {
-        return Err(PyValueError::new_err(format!(
-            "expected {n} RGB float32 pixels ({} bytes), got {} bytes",
-            n * 12,
-            pixels.len()
-        )));
-    }
+    let rgb = rgb_pixels(pixels, n, "pixels")?;
     let tonemap = Tonemap::from_str(tonemap, true).map_err(PyValueError::new_err)?;
     if gamma.is_some_and(|g| !(g.is_finite() && g > 0.0)) {
         return Err(PyValueError::new_err("gamma must be a positive number"));
     }
-    let f = |i: usize| f32::from_le_bytes(pixels[4 * i..4 * i + 4].try_into().unwrap());
-    let rgb: Vec<Vec3> = (0..n)
-        .map(|i| Vec3::new(f(3 * i), f(3 * i + 1), f(3 * i + 2)))
-        .collect();
     let display = DisplayTransform {
         exposure,
         tonemap,
