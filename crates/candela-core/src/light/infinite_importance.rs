@@ -54,20 +54,25 @@ fn sh9(d: Vec3) -> [f32; 9] {
     ]
 }
 
-impl SkyIrradiance {
-    /// From the luminance carried by small patches of the sphere: each `(d, lum · dω)`,
-    /// `d` a unit direction (the patches should cover the sphere; their sum is ∫ L dω).
-    pub fn from_patches(patches: impl IntoIterator<Item = (Vec3, f32)>) -> SkyIrradiance {
-        let mut l = [0.0f64; 9];
-        let mut fluence = 0.0f64;
-        for (d, w) in patches {
-            for (acc, y) in l.iter_mut().zip(sh9(d)) {
-                *acc += (y * w) as f64;
-            }
-            fluence += w as f64;
+/// Sums of luminance × the harmonics over patches of the sphere: the projection of the
+/// luminance onto them.
+#[derive(Default)]
+struct Projection {
+    l: [f64; 9],
+    fluence: f64,
+}
+
+impl Projection {
+    fn add(&mut self, y: &[f32; 9], w: f32) {
+        for (acc, y) in self.l.iter_mut().zip(y) {
+            *acc += (y * w) as f64;
         }
-        let l = l.map(|v| v as f32);
-        // E = Σ Â_l L_lm Y_lm(n) with Â = π, 2π/3, π/4, expanded into the quadratic form.
+        self.fluence += w as f64;
+    }
+
+    /// E = Σ Â_l L_lm Y_lm(n) with Â = π, 2π/3, π/4, expanded into the quadratic form.
+    fn irradiance(&self) -> SkyIrradiance {
+        let l = self.l.map(|v| v as f32);
         let (a1, a2) = (2.0 * PI / 3.0, PI / 4.0);
         let xy = a2 * 1.092_548 * l[4] / 2.0;
         let yz = a2 * 1.092_548 * l[5] / 2.0;
@@ -82,8 +87,20 @@ impl SkyIrradiance {
             ),
             b: a1 * 0.488_603 * Vec3::new(l[3], l[1], l[2]),
             c: PI * 0.282_095 * l[0] - a2 * 0.315_392 * l[6],
-            fluence: fluence as f32,
+            fluence: self.fluence as f32,
         }
+    }
+}
+
+impl SkyIrradiance {
+    /// From the luminance carried by small patches of the sphere: each `(d, lum · dω)`,
+    /// `d` a unit direction (the patches should cover the sphere; their sum is ∫ L dω).
+    pub fn from_patches(patches: impl IntoIterator<Item = (Vec3, f32)>) -> SkyIrradiance {
+        let mut sum = Projection::default();
+        for (d, w) in patches {
+            sum.add(&sh9(d), w);
+        }
+        sum.irradiance()
     }
 
     /// A sky of the same luminance `lum` everywhere: E = π·lum on every side.
@@ -151,12 +168,22 @@ impl SkyImportance {
     where
         I: Iterator<Item = (Vec3, f32, f32)> + Clone,
     {
-        let all = SkyIrradiance::from_patches(patches.clone().map(|(d, w, _)| (d, w)));
-        let area: f64 = patches.clone().map(|(_, _, a)| a as f64).sum();
-        let mean = (all.fluence as f64 / area) as f32;
-        let excess =
-            SkyIrradiance::from_patches(patches.map(|(d, w, a)| (d, (w - mean * a).max(0.0))));
-        SkyImportance { all, excess }
+        let (light, area) = patches
+            .clone()
+            .fold((0.0f64, 0.0f64), |(l, a), (_, w, da)| {
+                (l + w as f64, a + da as f64)
+            });
+        let mean = (light / area) as f32;
+        let (mut all, mut excess) = (Projection::default(), Projection::default());
+        for (d, w, da) in patches {
+            let y = sh9(d);
+            all.add(&y, w);
+            excess.add(&y, (w - mean * da).max(0.0));
+        }
+        SkyImportance {
+            all: all.irradiance(),
+            excess: excess.irradiance(),
+        }
     }
 
     /// A sky of luminance `lum` everywhere: nothing above its mean.

@@ -88,7 +88,59 @@ pub struct Bilinear2D {
     row_cdf: Vec<f32>,
     /// ∫₀^{y_j} ∫₀¹ f dx dy at each vertex row j.
     marginal_cdf: Vec<f32>,
+    /// Guide to `marginal_cdf`: one entry per row cell, and one more.
+    marginal_guide: Vec<u32>,
+    /// Guides to each vertex row's `row_cdf`: `ROW_GUIDE + 1` entries a row.
+    row_guides: Vec<u32>,
     integral: f32,
+}
+
+/// Parts of a vertex row's mass its guide marks.
+const ROW_GUIDE: usize = 64;
+
+/// For a non-decreasing `cdf` over `cells` cells (`cells + 1` entries from 0), entry g
+/// of `parts + 1` is the last cell k with cdf[k] ≤ g/parts of the total.
+fn guide(cdf: &[f32], parts: usize) -> Vec<u32> {
+    let cells = cdf.len() - 1;
+    let total = cdf[cells];
+    let mut k = 0;
+    (0..=parts)
+        .map(|g| {
+            let threshold = total * (g as f32 / parts as f32);
+            while k + 1 < cells && cdf[k + 1] <= threshold {
+                k += 1;
+            }
+            k as u32
+        })
+        .collect()
+}
+
+/// The last cell k < `cells` with cdf(k) ≤ `target` (cdf(0) = 0 ≤ target), by binary
+/// search between the guesses `lo` and `hi` (cdf(lo) ≤ target < cdf(hi)), widened to
+/// the whole range where either does not hold.
+#[inline]
+fn last_at_or_below(
+    cdf: impl Fn(usize) -> f32,
+    target: f32,
+    cells: usize,
+    lo: usize,
+    hi: usize,
+) -> usize {
+    let mut lo = if cdf(lo) <= target { lo } else { 0 };
+    let mut hi = if hi > lo && hi < cells && cdf(hi) > target {
+        hi
+    } else {
+        cells
+    };
+    while hi - lo > 1 {
+        let mid = (lo + hi) / 2;
+        if cdf(mid) <= target {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    lo
 }
 
 impl Bilinear2D {
@@ -118,6 +170,11 @@ impl Bilinear2D {
             acc += 0.5 * (row_integrals[j] + row_integrals[j + 1]) * height;
             marginal_cdf.push(acc as f32);
         }
+        let marginal_guide = guide(&marginal_cdf, rows - 1);
+        let row_guides = row_cdf
+            .chunks_exact(stride)
+            .flat_map(|row| guide(row, ROW_GUIDE))
+            .collect();
         Bilinear2D {
             x_axis,
             y_axis,
@@ -125,6 +182,8 @@ impl Bilinear2D {
             values,
             row_cdf,
             marginal_cdf,
+            marginal_guide,
+            row_guides,
             integral: acc as f32,
         }
     }
@@ -170,7 +229,13 @@ impl Bilinear2D {
         }
         // The row cell, from the marginal: linear from one vertex row's integral to the
         // next's.
-        let (j, xi) = find_interval(&self.marginal_cdf, u.y * self.integral);
+        let target = u.y * self.integral;
+        let m = &self.marginal_cdf;
+        let cells = m.len() - 1;
+        let g = ((u.y * cells as f32) as usize).min(cells - 1);
+        let (lo, hi) = (self.marginal_guide[g], self.marginal_guide[g + 1] + 1);
+        let j = last_at_or_below(|j| m[j], target, cells, lo as usize, hi as usize);
+        let xi = unit_within(m[j], m[j + 1], target);
         let row_integral = |j: usize| self.row_cdf[(j + 1) * self.stride - 1];
         let t = sample_linear(xi, row_integral(j), row_integral(j + 1));
         let (y0, y1) = (self.y_axis.position(j), self.y_axis.position(j + 1));
@@ -181,24 +246,15 @@ impl Bilinear2D {
         let top = &self.row_cdf[j * self.stride..(j + 1) * self.stride];
         let bottom = &self.row_cdf[(j + 1) * self.stride..(j + 2) * self.stride];
         let cdf = |k: usize| top[k] + t * (bottom[k] - top[k]);
-        let target = u.x * cdf(self.stride - 1);
-        // The last vertex k < stride − 1 with cdf(k) ≤ target.
-        let (mut lo, mut hi) = (0usize, self.stride - 1);
-        while hi - lo > 1 {
-            let mid = (lo + hi) / 2;
-            if cdf(mid) <= target {
-                lo = mid;
-            } else {
-                hi = mid;
-            }
-        }
-        let k = lo;
-        let (c0, c1) = (cdf(k), cdf(k + 1));
-        let xi = if c1 > c0 {
-            ((target - c0) / (c1 - c0)).clamp(0.0, ONE_MINUS_EPSILON)
-        } else {
-            0.0
-        };
+        let cells = self.stride - 1;
+        let target = u.x * cdf(cells);
+        let g = ((u.x * ROW_GUIDE as f32) as usize).min(ROW_GUIDE - 1);
+        let guides = &self.row_guides[j * (ROW_GUIDE + 1)..(j + 2) * (ROW_GUIDE + 1)];
+        let (top_guide, bottom_guide) = guides.split_at(ROW_GUIDE + 1);
+        let lo = top_guide[g].min(bottom_guide[g]) as usize;
+        let hi = top_guide[g + 1].max(bottom_guide[g + 1]) as usize + 1;
+        let k = last_at_or_below(cdf, target, cells, lo, hi);
+        let xi = unit_within(cdf(k), cdf(k + 1), target);
         let i = j * self.stride + k;
         let v = &self.values;
         let f0 = v[i] + t * (v[i + self.stride] - v[i]);
@@ -211,22 +267,14 @@ impl Bilinear2D {
     }
 }
 
-/// For a non-decreasing `cdf` starting at 0 and a `target` in [0, its last entry): the
-/// interval `j` with `cdf[j] ≤ target < cdf[j + 1]` (never an empty one) and where the
-/// target falls within it, in [0, 1).
-fn find_interval(cdf: &[f32], target: f32) -> (usize, f32) {
-    let last = cdf.len() - 2;
-    let j = cdf
-        .partition_point(|&c| c <= target)
-        .saturating_sub(1)
-        .min(last);
-    let (c0, c1) = (cdf[j], cdf[j + 1]);
-    let xi = if c1 > c0 {
+/// Where `target` lies between `c0` and `c1`, in [0, 1); 0 for an empty interval.
+#[inline]
+fn unit_within(c0: f32, c1: f32, target: f32) -> f32 {
+    if c1 > c0 {
         ((target - c0) / (c1 - c0)).clamp(0.0, ONE_MINUS_EPSILON)
     } else {
         0.0
-    };
-    (j, xi)
+    }
 }
 
 #[cfg(test)]
@@ -292,6 +340,59 @@ mod tests {
             let (p, pdf) = d.sample(u).expect("inside the support");
             assert!(pdf > 0.0 && (0.0..1.0).contains(&p.x) && (0.0..1.0).contains(&p.y));
             assert!((d.pdf(p) - pdf).abs() <= 1e-4 * pdf.max(1.0), "{p} {pdf}");
+        }
+    }
+
+    /// [`Bilinear2D::sample`]'s searches without the guides: plain binary searches.
+    fn unguided_cells(d: &Bilinear2D, u: Vec2) -> (usize, usize) {
+        let full = |cdf: &dyn Fn(usize) -> f32, target, cells| {
+            last_at_or_below(cdf, target, cells, 0, cells)
+        };
+        let m = &d.marginal_cdf;
+        let j = full(&|j| m[j], u.y * d.integral, m.len() - 1);
+        let xi = unit_within(m[j], m[j + 1], u.y * d.integral);
+        let row = |j: usize| d.row_cdf[(j + 1) * d.stride - 1];
+        let t = sample_linear(xi, row(j), row(j + 1));
+        let (top, bottom) = (&d.row_cdf[j * d.stride..], &d.row_cdf[(j + 1) * d.stride..]);
+        let cdf = |k: usize| top[k] + t * (bottom[k] - top[k]);
+        let cells = d.stride - 1;
+        (j, full(&cdf, u.x * cdf(cells), cells))
+    }
+
+    #[test]
+    fn guided_searches_find_the_cells_binary_searches_find() {
+        // A 257 × 130 grid with a bright spot, empty stretches and a ramp, and 2·10⁵
+        // samples: the guided sample's cells are the plain searches' cells.
+        let (w, h) = (257, 130);
+        let mut values = vec![0.0f32; w * h];
+        for (i, v) in values.iter_mut().enumerate() {
+            let (x, y) = (i % w, i / w);
+            *v = match (x / 40, y / 30) {
+                (1, _) | (_, 2) => 0.0,
+                _ => 0.1 + (x as f32 / w as f32) * ((i * 7919) % 13) as f32,
+            };
+            if (120..124).contains(&x) && (60..63).contains(&y) {
+                *v = 5e4;
+            }
+        }
+        let d = Bilinear2D::new(values, GridAxis::Even(w - 1), GridAxis::Centred(h - 2));
+        let mut state = 0x9e37_79b9u32;
+        let mut next = || {
+            state ^= state << 13;
+            state ^= state >> 17;
+            state ^= state << 5;
+            (state >> 8) as f32 / (1u32 << 24) as f32
+        };
+        for _ in 0..200_000 {
+            let u = Vec2::new(next(), next());
+            let (p, _) = d.sample(u).expect("positive there");
+            let (j, k) = unguided_cells(&d, u);
+            let (x0, x1) = (d.x_axis.position(k), d.x_axis.position(k + 1));
+            let (y0, y1) = (d.y_axis.position(j), d.y_axis.position(j + 1));
+            assert!(
+                (x0..=x1).contains(&p.x) && (y0..=y1).contains(&p.y),
+                "{u}: {p}"
+            );
         }
     }
 

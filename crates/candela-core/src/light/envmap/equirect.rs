@@ -1,12 +1,13 @@
 //! The latitude-longitude (equirectangular) panorama.
 
-use std::f32::consts::PI;
+use std::f32::consts::{FRAC_1_PI, PI};
 
 use glam::{Vec2, Vec3, Vec4};
 
 use super::bilinear::{Bilinear2D, GridAxis};
 use super::{Image, MapSample};
-use crate::math::luminance;
+use crate::math::{atan2_poly, luminance};
+use crate::sampling::sin_cos_quarter_turns;
 
 /// A panorama in the native mapping of [`super`]: y up, centre along −z.
 ///
@@ -30,18 +31,33 @@ pub struct Equirect {
 
 /// Image coordinates (u right, v down, both in [0,1]) of a unit direction.
 pub fn direction_to_uv(d: Vec3) -> Vec2 {
-    let u = 0.5 * (1.0 + d.x.atan2(-d.z) / PI);
-    let v = d.y.clamp(-1.0, 1.0).acos() / PI;
-    Vec2::new(u, v)
+    direction_to_uv_sin(d).0
+}
+
+/// [`direction_to_uv`] and sin θ = √(x² + z²), which it computes on the way (θ as
+/// atan2(sin θ, cos θ), both angles by [`atan2_poly`]: a third of libm's `atan2f` and
+/// `acosf`, as accurate).
+#[inline]
+fn direction_to_uv_sin(d: Vec3) -> (Vec2, f32) {
+    let sin_theta = (d.x * d.x + d.z * d.z).sqrt();
+    let u = 0.5 * (1.0 + atan2_poly(d.x, -d.z) * FRAC_1_PI);
+    let v = atan2_poly(sin_theta, d.y) * FRAC_1_PI;
+    (Vec2::new(u, v), sin_theta)
 }
 
 /// The unit direction at image coordinates `uv`; the inverse of [`direction_to_uv`].
 pub fn uv_to_direction(uv: Vec2) -> Vec3 {
-    let phi = PI * (2.0 * uv.x - 1.0);
-    let theta = PI * uv.y;
-    let (st, ct) = theta.sin_cos();
-    let (sp, cp) = phi.sin_cos();
-    Vec3::new(st * sp, ct, -st * cp)
+    uv_to_direction_sin(uv).0
+}
+
+/// [`uv_to_direction`] and the sin θ it computes on the way. The angles, φ = π(2u − 1)
+/// and θ = πv, are taken in quarter turns ([`sin_cos_quarter_turns`]: polynomials, no
+/// library calls).
+#[inline]
+fn uv_to_direction_sin(uv: Vec2) -> (Vec3, f32) {
+    let (st, ct) = sin_cos_quarter_turns(2.0 * uv.y);
+    let (sp, cp) = sin_cos_quarter_turns(4.0 * uv.x - 2.0);
+    (Vec3::new(st * sp, ct, -st * cp), st)
 }
 
 /// The share of a texel's luminance that its sampling weight keeps at least, below the
@@ -141,8 +157,8 @@ impl Equirect {
     /// The radiance towards unit direction `d` and the solid-angle density with which
     /// [`Self::sample`] draws `d`, from one lookup.
     pub fn eval_pdf(&self, d: Vec3) -> (Vec3, f32) {
-        let c = self.lookup(self.grid_point(direction_to_uv(d)));
-        let sin_theta = (d.x * d.x + d.z * d.z).sqrt();
+        let (uv, sin_theta) = direction_to_uv_sin(d);
+        let c = self.lookup(self.grid_point(uv));
         let integral = self.distribution.integral();
         let pdf = if sin_theta > 0.0 && integral > 0.0 {
             c.w / (integral * UV_TO_SOLID_ANGLE * sin_theta)
@@ -158,12 +174,12 @@ impl Equirect {
         let (p, pdf_grid) = self.distribution.sample(u)?;
         let x = p.x + 0.5 / self.image.width as f32;
         let uv = Vec2::new(if x >= 1.0 { x - 1.0 } else { x }, p.y);
-        let sin_theta = (PI * uv.y).sin();
+        let (dir, sin_theta) = uv_to_direction_sin(uv);
         if sin_theta <= 0.0 {
             return None;
         }
         Some(MapSample {
-            dir: uv_to_direction(uv),
+            dir,
             pdf: pdf_grid / (UV_TO_SOLID_ANGLE * sin_theta),
             radiance: self.lookup(p).truncate(),
         })
@@ -178,14 +194,18 @@ impl Equirect {
     pub fn luminance_patches(&self) -> impl Iterator<Item = (Vec3, f32, f32)> + Clone + '_ {
         let (w, h) = (self.image.width, self.image.height);
         let texel_area = UV_TO_SOLID_ANGLE / (w * h) as f32;
+        // The angles' sines and cosines by row and by column, not by texel.
+        let rows: Vec<(f32, f32)> = (0..h)
+            .map(|j| sin_cos_quarter_turns(2.0 * (j as f32 + 0.5) / h as f32))
+            .collect();
+        let cols: Vec<(f32, f32)> = (0..w)
+            .map(|i| sin_cos_quarter_turns(4.0 * (i as f32 + 0.5) / w as f32 - 2.0))
+            .collect();
         self.image.pixels.iter().enumerate().map(move |(i, &l)| {
-            let uv = Vec2::new(
-                ((i % w) as f32 + 0.5) / w as f32,
-                ((i / w) as f32 + 0.5) / h as f32,
-            );
-            let sin_theta = (PI * uv.y).sin();
-            let area = sin_theta * texel_area;
-            (uv_to_direction(uv), luminance(l).max(0.0) * area, area)
+            let ((st, ct), (sp, cp)) = (rows[i / w], cols[i % w]);
+            let area = st * texel_area;
+            let d = Vec3::new(st * sp, ct, -st * cp);
+            (d, luminance(l).max(0.0) * area, area)
         })
     }
 
