@@ -24,7 +24,6 @@ after the first in the process, JIT excluded). Images are kept in bench/out/medi
 """
 
 import argparse
-import math
 import os
 import statistics
 import sys
@@ -35,7 +34,7 @@ BENCH_DIR = os.path.dirname(os.path.abspath(__file__))
 REPO = os.path.dirname(BENCH_DIR)
 sys.path.insert(0, BENCH_DIR)
 
-from benchlib import candela, images, machine, mitsuba_render, report  # noqa: E402
+from benchlib import candela, images, machine, mitsuba_render, report, stats  # noqa: E402
 import compare_mitsuba  # noqa: E402  (its box-filter copy and -D parameters)
 
 OUT = os.path.join(BENCH_DIR, "out", "media_tiles")
@@ -46,46 +45,6 @@ TILE = images.TILE
 # failure once in a hundred scene comparisons).
 ALPHA_TILE = 0.001
 ALPHA_FAMILY = 0.01
-
-
-def betainc(a: float, b: float, x: float) -> float:
-    """The regularized incomplete beta I_x(a, b), by its continued fraction (Numerical
-    Recipes §6.4, modified Lentz)."""
-    if x <= 0.0:
-        return 0.0
-    if x >= 1.0:
-        return 1.0
-    if x > (a + 1.0) / (a + b + 2.0):
-        return 1.0 - betainc(b, a, 1.0 - x)
-    ln_front = (math.lgamma(a + b) - math.lgamma(a) - math.lgamma(b)
-                + a * math.log(x) + b * math.log1p(-x))
-    tiny = 1e-300
-    c, d = 1.0, 1.0 - (a + b) * x / (a + 1.0)
-    d = 1.0 / (d if abs(d) > tiny else tiny)
-    f = d
-    for m in range(1, 500):
-        for num in (m * (b - m) * x / ((a + 2 * m - 1) * (a + 2 * m)),
-                    -(a + m) * (a + b + m) * x / ((a + 2 * m) * (a + 2 * m + 1))):
-            d = 1.0 + num * d
-            d = 1.0 / (d if abs(d) > tiny else tiny)
-            c = 1.0 + num / c
-            c = c if abs(c) > tiny else tiny
-            f *= c * d
-        if abs(c * d - 1.0) < 1e-12:
-            break
-    return math.exp(ln_front) * f / a
-
-
-def welch_p(x: np.ndarray, y: np.ndarray) -> tuple:
-    """Welch's t and its two-sided p-value for samples x and y (the Welch–Satterthwaite
-    degrees of freedom)."""
-    vx, vy = x.var(ddof=1) / len(x), y.var(ddof=1) / len(y)
-    se2 = vx + vy
-    if se2 <= 0.0:
-        return 0.0, 1.0 if x.mean() == y.mean() else 0.0
-    t = (x.mean() - y.mean()) / math.sqrt(se2)
-    df = se2 ** 2 / (vx ** 2 / (len(x) - 1) + vy ** 2 / (len(y) - 1))
-    return t, betainc(df / 2.0, 0.5, df / (df + t * t))
 
 
 def tile_means(img: np.ndarray) -> np.ndarray:
@@ -132,7 +91,7 @@ def compare(scene: str, a) -> str:
     for j in range(ty):
         for i in range(tx):
             for c in range(3):
-                t, p = welch_p(tiles["candela"][:, j, i, c], tiles["mitsuba"][:, j, i, c])
+                t, p = stats.welch(tiles["candela"][:, j, i, c], tiles["mitsuba"][:, j, i, c])
                 t_map[j, i, c] = t
                 p_min = min(p_min, p)
                 flagged += p < ALPHA_TILE

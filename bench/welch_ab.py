@@ -13,7 +13,6 @@ Usage: bench/welch_ab.sh --a /work/bin/candela-main --b target/release/candela \
 """
 
 import argparse
-import math
 import os
 import subprocess
 import sys
@@ -24,47 +23,9 @@ import numpy as np
 BENCH_DIR = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, BENCH_DIR)
 
-from benchlib import images  # noqa: E402
+from benchlib import images, stats  # noqa: E402
 
 LUMA = np.array([0.2126, 0.7152, 0.0722])
-
-
-def betainc(a: float, b: float, x: float) -> float:
-    """Regularized incomplete beta I_x(a, b) (Numerical Recipes §6.4)."""
-    if x <= 0.0:
-        return 0.0
-    if x >= 1.0:
-        return 1.0
-    front = math.exp(math.lgamma(a + b) - math.lgamma(a) - math.lgamma(b)
-                     + a * math.log(x) + b * math.log1p(-x))
-    if x > (a + 1.0) / (a + b + 2.0):
-        return 1.0 - betainc(b, a, 1.0 - x)
-    # Lentz's continued fraction.
-    tiny = 1e-300
-    c, d = 1.0, 1.0 - (a + b) * x / (a + 1.0)
-    d = 1.0 / (d if abs(d) > tiny else tiny)
-    f = d
-    for m in range(1, 300):
-        for num in (m * (b - m) * x / ((a + 2 * m - 1) * (a + 2 * m)),
-                    -(a + m) * (a + b + m) * x / ((a + 2 * m) * (a + 2 * m + 1))):
-            d = 1.0 + num * d
-            d = 1.0 / (d if abs(d) > tiny else tiny)
-            c = 1.0 + num / c
-            c = c if abs(c) > tiny else tiny
-            f *= c * d
-        if abs(c * d - 1.0) < 1e-14:
-            break
-    return front * f / a
-
-
-def welch_p(x: np.ndarray, y: np.ndarray) -> float:
-    """Two-sided p-value of Welch's t-test that x and y have the same mean."""
-    vx, vy = x.var(ddof=1) / len(x), y.var(ddof=1) / len(y)
-    if vx + vy == 0.0:
-        return 1.0 if x.mean() == y.mean() else 0.0
-    t = (x.mean() - y.mean()) / math.sqrt(vx + vy)
-    df = (vx + vy) ** 2 / (vx ** 2 / (len(x) - 1) + vy ** 2 / (len(y) - 1))
-    return betainc(df / 2.0, 0.5, df / (df + t * t))
 
 
 def renders(binary: str, a, seed_base: int, tmp: str) -> np.ndarray:
@@ -99,7 +60,7 @@ def main() -> None:
     t = a.res // a.tile
     lum = lambda r: (r @ LUMA).reshape(len(r), t, a.tile, t, a.tile).mean(axis=(2, 4))
     ta, tb = lum(ra).reshape(len(ra), -1), lum(rb).reshape(len(rb), -1)
-    p = np.array([welch_p(ta[:, i], tb[:, i]) for i in range(ta.shape[1])])
+    p = np.array([stats.welch(ta[:, i], tb[:, i])[1] for i in range(ta.shape[1])])
     fails = int((p < a.alpha).sum())
     differ = int((np.abs(same_seed[0] - ra[0]).max(axis=-1) > 0).sum())
     var = [float(r.var(axis=0, ddof=1).mean()) for r in (ra, rb)]
