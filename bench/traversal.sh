@@ -7,7 +7,8 @@
 #    tracing the same diffuse-bounce rays, alternately, in one run.
 # 3. The same for Candela alone on `mixed`: a room whose leaf blocks mix analytic spheres
 #    and alpha-masked triangles with plain ones (Embree via embreex has triangles only).
-# CANDELA_NODES=full|quantized picks the BVH's node layout (default: the library's).
+# CANDELA_NODES=full|quantized picks the BVH's node layout and CANDELA_LEAVES=inline|indexed
+# its leaf layout (default: the library's).
 set -euo pipefail
 here="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"
 root="$(dirname "$here")"

@@ -13,8 +13,9 @@ reached, the rest being the build's) and the process's user + system CPU from
 (JIT compile included for llvm_ad_rgb) timed inside its process, that process's user +
 system CPU (Python's import of Mitsuba included) and its peak RSS. On a shared machine
 compare CPU seconds and memory: wall times there measure the other tenants. Bytes per
-triangle are the whole process's peak over the triangle count. The Markdown table goes
-to stdout and bench/out/bigscene.md.
+triangle are the whole process's peak over the triangle count. `--accel` is Candela's
+leaf layout (auto, inline, compact); `--variants ""` runs Candela alone. The Markdown
+table goes to stdout and bench/out/bigscene.md. The instanced scene is gen_instanced.py's.
 """
 
 import argparse

@@ -95,10 +95,11 @@ impl IndexedLeaves {
     #[inline(always)]
     pub fn block(&self, first: u32, count: u32) -> Block {
         let records = &self.records[first as usize..(first + count) as usize];
-        Block::gather(records.len(), |lane| {
-            let [a, b, c, id] = records[lane];
-            ([a, b, c].map(|v| self.points[v as usize]), id)
-        })
+        Block::gather(
+            records
+                .iter()
+                .map(|&[a, b, c, id]| ([a, b, c].map(|v| self.points[v as usize]), id)),
+        )
     }
 
     /// The address of record `first`, to prefetch.
