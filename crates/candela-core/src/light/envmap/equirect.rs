@@ -19,7 +19,7 @@ use crate::sampling::sin_cos_quarter_turns;
 /// blend of a weight × sin θ at the vertices (zero at the poles), sampled exactly
 /// ([`Bilinear2D`]): as Mitsuba 3's `envmap`, so the density follows the radiance within
 /// every texel, a sun's rim included, not a step function over it. The weight is the
-/// luminance above the map's mean (with a floor: see [`compensated`]).
+/// luminance above half the map's mean (with a floor: see [`compensated`]).
 #[derive(Clone, Debug)]
 pub struct Equirect {
     pub image: Image,

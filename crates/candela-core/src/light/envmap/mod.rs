@@ -11,8 +11,8 @@
 //!
 //! Both sample a bilinear density through the texel centres (and the edges, where the
 //! lookup clamps), so that the density follows the filtered radiance within every texel
-//! ([`bilinear`], as Mitsuba 3's `envmap`); its weights are the luminance above the map's
-//! mean, floored ([`compensated`]), times the mapping's Jacobian. The density is positive
+//! ([`bilinear`], as Mitsuba 3's `envmap`); its weights are the luminance above half the
+//! map's mean, floored ([`compensated`]), times the mapping's Jacobian. The density is positive
 //! wherever the filtered radiance is.
 
 pub mod bilinear;
@@ -35,23 +35,30 @@ pub struct MapSample {
     pub radiance: Vec3,
 }
 
-/// The share of a texel's luminance that its sampling weight keeps at least, below the
-/// mean (see [`compensated`]).
+/// The fraction of the map's mean luminance that [`compensated`] subtracts.
+const COMPENSATION: f32 = 0.5;
+
+/// The share of a texel's luminance that its sampling weight keeps at least.
 const COMPENSATION_FLOOR: f32 = 1.0 / 16.0;
 
 /// The sampling weight of a texel of luminance `lum` in a map of mean luminance `mean`:
-/// what exceeds the mean, and never under a sixteenth of the texel's own luminance. MIS
-/// compensation (Karlík et al. 2019, "MIS Compensation: Optimizing Sampling Techniques in
-/// Multiple Importance Sampling"; Mitsuba 3's `mis_compensation`, off by default there):
-/// with MIS, BSDF sampling finds an even sky's light as well as light sampling does, so
-/// light samples are worth more on what stands out (a sun) than spread over the rest.
-/// The floor keeps the density positive wherever the radiance is, so that light sampling
-/// without MIS stays unbiased. Measured on `bench/scenes/hdr-sky-sun.xml` (RESULTS.md,
-/// `## equal_spp`): relMSE −19 % at 64 spp against the uncompensated bilinear density,
-/// floors of 0 to ¼ within 6 % of each other.
+/// what exceeds half the mean, and never under a sixteenth of the texel's own luminance.
+/// MIS compensation (Karlík et al. 2019, "MIS Compensation: Optimizing Sampling
+/// Techniques in Multiple Importance Sampling", who subtract the whole mean; Mitsuba 3's
+/// `mis_compensation`, off by default there): with MIS, BSDF sampling finds an even
+/// sky's light about as well as light sampling does, so light samples are worth more on
+/// what stands out (a sun) than spread over the rest. The floor keeps the density
+/// positive wherever the radiance is, so that light sampling without MIS stays unbiased.
+///
+/// Half the mean, not all of it: relMSE at equal spp against the uncompensated bilinear
+/// density (bench/RESULTS.md, `## env_paths`) was 0.83× (half) and 0.81× (whole) on
+/// `bench/scenes/hdr-sky-sun.xml`, 64 spp, 8 seeds; 0.90× and 1.43× on `bench/env_mis.sh`'s
+/// synthetic sky, 16 spp, 16 seeds, whose smooth sky lies wholly below its mean, so that
+/// subtracting all of it left the sky's light to BSDF sampling alone. Floors of 0 to ¼
+/// changed hdr-sky-sun by under 6 %.
 pub(crate) fn compensated(lum: f32, mean: f32) -> f32 {
     let lum = lum.max(0.0);
-    (lum - mean).max(COMPENSATION_FLOOR * lum)
+    (lum - COMPENSATION * mean).max(COMPENSATION_FLOOR * lum)
 }
 
 /// A linear RGB image, row-major, top row first.
