@@ -5,7 +5,7 @@
 //! Chi-square tests use `candela_core::chi2` on the sphere (cells in φ and cos θ about
 //! the z axis, unrelated to the maps' own grids) or, for the bilinear density itself, on
 //! the unit square, 10⁶ samples each, at a suite-wide significance of 0.01 split over the
-//! four tests by Šidák's correction. Two of them have histogram cells much finer than
+//! five tests by Šidák's correction. Three of them have histogram cells much finer than
 //! the texels, so that the density's shape within a texel is tested, not only its mass.
 
 use std::f32::consts::PI;
@@ -17,7 +17,7 @@ use candela_core::light::{EnvironmentLight, EnvironmentMap, LightSource, Shading
 use glam::{Mat3, Vec2, Vec3};
 
 /// Chi-square tests in this file, for the Šidák correction.
-const CHI2_TESTS: usize = 4;
+const CHI2_TESTS: usize = 5;
 
 fn chi2_test() -> ChiSquareTest {
     ChiSquareTest {
@@ -203,6 +203,23 @@ fn cubemap_sampling_matches_pdf_chi_square() {
         let s = l.sample_li(&ctx(), rng.next_2d()).unwrap();
         assert_ne!(cubemap::direction_to_face(s.wi).0, 3, "{}", s.wi);
     }
+}
+
+#[test]
+fn coarse_cube_map_sampling_matches_pdf_chi_square() {
+    // Faces of 3 × 3 texels, a bright one among them: each texel spans about ten of the
+    // 64 × 32 histogram cells across, so the bilinear shape within texels and the
+    // half-texels at the faces' edges are tested.
+    let mut faces = coloured_cube(3);
+    faces[4].pixels[5] *= 30.0;
+    let l = light(EnvironmentMap::Cubemap(Cubemap::new(faces)));
+    let report = chi2_test().spherical(
+        "cube map 3×3",
+        |u| l.sample_li(&ctx(), u).map(|s| s.wi),
+        |d| l.pdf_li(&ctx(), d),
+    );
+    println!("{report}");
+    report.assert_passed();
 }
 
 #[test]

@@ -19,12 +19,15 @@
 //! meet seamlessly. Bilinear filtering clamps at face edges (no filtering across faces).
 //!
 //! Sampling works on the faces directly: face `f` is chosen in proportion to its share
-//! of the importance, then a half-texel cell by a 2D distribution weighted by the texel's
-//! solid angle, dω = 4 (1 + a² + b²)^(−3/2) ds dt with a = 2s − 1, b = 2t − 1.
+//! of the importance, then a point of it by a bilinear density through its texel centres
+//! and edges ([`Bilinear2D`]), weighted by the luminance above half the map's mean
+//! ([`compensated`]) times the solid angle, dω = 4 (1 + a² + b²)^(−3/2) ds dt with
+//! a = 2s − 1, b = 2t − 1.
 
 use glam::{Vec2, Vec3};
 
-use super::{Distribution2D, Image, MapSample};
+use super::bilinear::{Bilinear2D, GridAxis};
+use super::{compensated, Image, MapSample};
 use crate::math::luminance;
 use crate::sampling::Distribution1D;
 
@@ -32,7 +35,8 @@ use crate::sampling::Distribution1D;
 #[derive(Clone, Debug)]
 pub struct Cubemap {
     pub faces: Box<[Image; 6]>,
-    distributions: Vec<Distribution2D>,
+    /// Per face, boxed to keep [`crate::light::Light`] small.
+    distributions: Box<[Bilinear2D; 6]>,
     face_distribution: Distribution1D,
 }
 
@@ -85,13 +89,35 @@ pub fn face_to_direction(face: usize, st: Vec2) -> Vec3 {
 impl Cubemap {
     /// The faces must be square and of equal size (the build checks).
     pub fn new(faces: Box<[Image; 6]>) -> Cubemap {
-        let mut distributions = Vec::with_capacity(6);
-        let mut weights = [0.0f32; 6];
-        for (f, img) in faces.iter().enumerate() {
-            let imp = img.half_texel_importance(false, solid_angle_jacobian);
-            weights[f] = (imp.iter().map(|&x| x as f64).sum::<f64>() / imp.len() as f64) as f32;
-            distributions.push(Distribution2D::new(&imp, 2 * img.width, 2 * img.height));
+        let n = faces[0].width;
+        let axis = GridAxis::Centred(n);
+        // The mean luminance over the sphere, texels weighted by their solid angle.
+        let (mut light, mut area) = (0.0f64, 0.0f64);
+        for img in faces.iter() {
+            for (i, &l) in img.pixels.iter().enumerate() {
+                let st = Vec2::new(
+                    ((i % n) as f32 + 0.5) / n as f32,
+                    ((i / n) as f32 + 0.5) / n as f32,
+                );
+                let a = solid_angle_jacobian(st) as f64;
+                light += luminance(l).max(0.0) as f64 * a;
+                area += a;
+            }
         }
+        let mean = (light / area) as f32;
+        let distributions = Box::new(faces.each_ref().map(|img| {
+            let texel = |k: usize| k.saturating_sub(1).min(n - 1);
+            let mut values = Vec::with_capacity(axis.vertices() * axis.vertices());
+            for j in 0..axis.vertices() {
+                for k in 0..axis.vertices() {
+                    let st = Vec2::new(axis.position(k), axis.position(j));
+                    let l = luminance(img.pixels[texel(j) * n + texel(k)]);
+                    values.push(compensated(l, mean) * solid_angle_jacobian(st));
+                }
+            }
+            Bilinear2D::new(values, axis, axis)
+        }));
+        let weights = distributions.each_ref().map(|d| d.integral());
         Cubemap {
             faces,
             distributions,
@@ -110,7 +136,7 @@ impl Cubemap {
         let (x, pdf_face, face) = self.face_distribution.sample_continuous(u.x);
         // Reuse the remainder of u.x within the chosen face's cell.
         let ux = (x * 6.0 - face as f32).clamp(0.0, crate::sampling::ONE_MINUS_EPSILON);
-        let (st, pdf_st) = self.distributions[face].sample(Vec2::new(ux, u.y));
+        let (st, pdf_st) = self.distributions[face].sample(Vec2::new(ux, u.y))?;
         let pdf = pdf_face / 6.0 * pdf_st / solid_angle_jacobian(st);
         (pdf > 0.0).then(|| MapSample {
             dir: face_to_direction(face, st),
@@ -141,21 +167,11 @@ impl Cubemap {
         })
     }
 
-    /// ∫ luminance(L) dω, by the midpoint rule over half-texels of the bilinear faces.
+    /// ∫ luminance(L) dω, by the midpoint rule over the texels.
     pub fn luminance_integral(&self) -> f32 {
-        let mut sum = 0.0f64;
-        for img in self.faces.iter() {
-            let (w2, h2) = (2 * img.width, 2 * img.height);
-            for qy in 0..h2 {
-                for qx in 0..w2 {
-                    let st =
-                        Vec2::new((qx as f32 + 0.5) / w2 as f32, (qy as f32 + 0.5) / h2 as f32);
-                    sum += (luminance(img.bilinear(st, false)) * solid_angle_jacobian(st)) as f64
-                        / (w2 * h2) as f64;
-                }
-            }
-        }
-        sum as f32
+        self.luminance_patches()
+            .map(|(_, w, _)| w as f64)
+            .sum::<f64>() as f32
     }
 }
 

@@ -5,7 +5,7 @@ use std::f32::consts::{FRAC_1_PI, PI};
 use glam::{Vec2, Vec3, Vec4};
 
 use super::bilinear::{Bilinear2D, GridAxis};
-use super::{Image, MapSample};
+use super::{compensated, Image, MapSample};
 use crate::math::{atan2_poly, luminance};
 use crate::sampling::sin_cos_quarter_turns;
 
@@ -19,7 +19,7 @@ use crate::sampling::sin_cos_quarter_turns;
 /// blend of a weight × sin θ at the vertices (zero at the poles), sampled exactly
 /// ([`Bilinear2D`]): as Mitsuba 3's `envmap`, so the density follows the radiance within
 /// every texel, a sun's rim included, not a step function over it. The weight is the
-/// luminance above the map's mean (with a floor: see [`compensated`]).
+/// luminance above half the map's mean (with a floor: see [`compensated`]).
 #[derive(Clone, Debug)]
 pub struct Equirect {
     pub image: Image,
@@ -58,25 +58,6 @@ fn uv_to_direction_sin(uv: Vec2) -> (Vec3, f32) {
     let (st, ct) = sin_cos_quarter_turns(2.0 * uv.y);
     let (sp, cp) = sin_cos_quarter_turns(4.0 * uv.x - 2.0);
     (Vec3::new(st * sp, ct, -st * cp), st)
-}
-
-/// The share of a texel's luminance that its sampling weight keeps at least, below the
-/// mean (see [`compensated`]).
-const COMPENSATION_FLOOR: f32 = 1.0 / 16.0;
-
-/// The sampling weight of a texel of luminance `lum` in a map of mean luminance `mean`:
-/// what exceeds the mean, and never under a sixteenth of the texel's own luminance. MIS
-/// compensation (Karlík et al. 2019, "MIS Compensation: Optimizing Sampling Techniques in
-/// Multiple Importance Sampling"; Mitsuba 3's `mis_compensation`, off by default there):
-/// with MIS, BSDF sampling finds an even sky's light as well as light sampling does, so
-/// light samples are worth more on what stands out (a sun) than spread over the rest.
-/// The floor keeps the density positive wherever the radiance is, so that light sampling
-/// without MIS stays unbiased. Measured on `bench/scenes/hdr-sky-sun.xml` (RESULTS.md,
-/// `## equal_spp`): relMSE −19 % at 64 spp against the uncompensated bilinear density,
-/// floors of 0 to ¼ within 6 % of each other.
-fn compensated(lum: f32, mean: f32) -> f32 {
-    let lum = lum.max(0.0);
-    (lum - mean).max(COMPENSATION_FLOOR * lum)
 }
 
 /// The mean luminance over the sphere, ∫ L dω / 4π, by texel (rows weighted by sin θ).
