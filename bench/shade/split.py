@@ -18,8 +18,9 @@ from collections import defaultdict
 # (stage, patterns on the source path or, for library code, the function's name)
 STAGES = [
     ("traversal", ["/accel/", "/bvh/", "candela-core/src/scene/mod.rs", "instance.rs",
+                   "candela-core/src/geometry.rs",
                    "candela_core::accel", "candela_core::bvh", "candela_core::scene::Scene::"]),
-    ("hit record", ["scene/interaction.rs", "scene/mesh.rs", "geometry.rs", "alpha.rs",
+    ("hit record", ["scene/interaction.rs", "scene/mesh.rs", "alpha.rs",
                     "candela_core::scene::interaction"]),
     ("film/splat", ["splat.rs", "film.rs", "exact_sum.rs", "filter.rs", "limb_sums.rs", "candela_core::splat",
                     "candela_core::film"]),
