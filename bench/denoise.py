@@ -1,7 +1,8 @@
-"""Denoising benchmark (issue #38): on the Cornell box and two other bundled scenes, a
-16-spp render denoised by Intel Open Image Denoise (`candela render --denoise`, guided
-by the albedo and normal passes, and `--denoise=color`, the beauty alone) against the raw
-16- and 256-spp renders, each compared with a 4096-spp reference of the same scene.
+"""Denoising benchmark (issue #38): on the Cornell box and other bundled scenes, a 16-spp
+render denoised by Intel Open Image Denoise (`candela render --denoise`, guided by the
+albedo and normal passes, and `--denoise=color`, the beauty alone) against the raw 16-
+and 256-spp renders, each compared with a reference of the same scene (4096 spp unless
+--ref-spp).
 
 Errors: relMSE with the worst 1 % of pixels dropped (per-pixel relMSE, mean over the
 channels, ε = 1e-2; a denoiser rightly softens the edges of directly seen lamps, which
