@@ -25,6 +25,10 @@ elsewhere hits them alike) and measures
   - with `--ipp`, instructions per camera path (callgrind, `bench/lanes/ipp.sh` at
     IPP_RES², 1 and 3 spp, one thread): load-independent cost per sample.
 
+A sampler may be given as LABEL=SAMPLER@BINARY to compare binaries: e.g.
+`--samplers bvh bvh-old=bvh@/path/to/old/candela` is the Welch comparison of a changed
+sampler against the previous one, with its variance ratio.
+
 Usage: bench/light_sampler.sh [--spp 16] [--seeds 8] [--size 128] [--threads 2]
                               [--samplers bvh uniform power] [--ipp] [--binary PATH]
                               [SCENE ...]
@@ -83,9 +87,17 @@ def light_count(binary: str, scene: str) -> int:
     return int(m.group(1)) if m else -1
 
 
-def render(binary: str, scene: str, sampler: str, seed: int, res: str, a) -> tuple:
+def config(spec: str, binary: str) -> tuple:
+    """(label, sampler, binary) from SAMPLER or LABEL=SAMPLER@BINARY."""
+    label, _, rest = spec.rpartition("=")
+    sampler, _, other = rest.partition("@")
+    return label or sampler, sampler, other or binary
+
+
+def render(cfg: tuple, scene: str, seed: int, res: str, a) -> tuple:
     """One render: its image and the CPU seconds of the whole process."""
-    out = os.path.join(OUT, f"{os.path.basename(scene)}_{sampler}_{seed}.pfm")
+    label, sampler, binary = cfg
+    out = os.path.join(OUT, f"{os.path.basename(scene)}_{label}_{seed}.pfm")
     cmd = [binary, "render", scene, "-o", out, "--spp", str(a.spp), "--seed", str(seed),
            "--threads", str(a.threads), "--res", res, "--light-sampler", sampler]
     r0 = os.times()
@@ -109,7 +121,8 @@ def welch_fails(x: list, y: list) -> tuple:
     return int((p < WELCH_ALPHA).sum()), len(p)
 
 
-def ipp(binary: str, scene: str, sampler: str) -> int:
+def ipp(cfg: tuple, scene: str) -> int:
+    _, sampler, binary = cfg
     p = subprocess.run([os.path.join(BENCH_DIR, "lanes", "ipp.sh"), binary, scene,
                         str(IPP_RES), "1", "3", "--light-sampler", sampler],
                        cwd=REPO, capture_output=True, text=True, check=True)
@@ -139,7 +152,9 @@ def main() -> None:
     if a.seeds < 2:
         ap.error("--seeds must be at least 2 (the error is the variance across seeds)")
     os.makedirs(OUT, exist_ok=True)
-    cand, others = a.samplers[0], a.samplers[1:]
+    cfgs = {c[0]: c for c in (config(spec, a.binary) for spec in a.samplers)}
+    labels = list(cfgs)
+    cand, others = labels[0], labels[1:]
     print(f"[light_sampler] {machine.cpu_model()}, load {machine.loadavg()}, "
           f"git {machine.git_revision(REPO)}, binary {a.binary}", flush=True)
     t0 = time.time()
@@ -149,15 +164,15 @@ def main() -> None:
         res = resolution(scene, a.size)
         w, h = (int(v) for v in res.split("x"))
         samples = w * h * a.spp
-        runs = {s: [] for s in a.samplers}
+        runs = {s: [] for s in labels}
         for seed in range(1, a.seeds + 1):
-            for s in a.samplers:
-                runs[s].append(render(a.binary, scene, s, seed, res, a))
-        imgs = {s: [img for img, _ in runs[s]] for s in a.samplers}
-        cpu = {s: sum(c for _, c in runs[s]) for s in a.samplers}
+            for s in labels:
+                runs[s].append(render(cfgs[s], scene, seed, res, a))
+        imgs = {s: [img for img, _ in runs[s]] for s in labels}
+        cpu = {s: sum(c for _, c in runs[s]) for s in labels}
         rel = relative_variances(imgs)
-        tiles = {s: tile_sums(rel[s]) for s in a.samplers}
-        counts = {s: ipp(a.binary, scene, s) for s in a.samplers} if a.ipp else {}
+        tiles = {s: tile_sums(rel[s]) for s in labels}
+        counts = {s: ipp(cfgs[s], scene) for s in labels} if a.ipp else {}
         row = [scene, light_count(a.binary, scene), res,
                f"{rel[cand].mean():.3e}",
                f"{cpu[cand] / a.seeds / samples * 1e9:.0f}"]

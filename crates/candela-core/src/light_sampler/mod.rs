@@ -19,7 +19,7 @@ mod bvh;
 pub mod ris;
 
 pub use array::LightArray;
-pub use bvh::LightBvh;
+pub use bvh::{LightBvh, FLAT_MAX};
 pub use ris::Ris;
 
 use crate::light::{Light, LightId, ShadingCtx};
