@@ -97,7 +97,9 @@ def config(spec: str, binary: str) -> tuple:
 def render(cfg: tuple, scene: str, seed: int, res: str, a) -> tuple:
     """One render: its image and the CPU seconds of the whole process."""
     label, sampler, binary = cfg
-    out = os.path.join(OUT, f"{os.path.basename(scene)}_{label}_{seed}.pfm")
+    # One folder per run (its process id), so that runs side by side do not share files.
+    out = os.path.join(OUT, str(os.getpid()),
+                       f"{os.path.basename(scene)}_{label}_{seed}.pfm")
     cmd = [binary, "render", scene, "-o", out, "--spp", str(a.spp), "--seed", str(seed),
            "--threads", str(a.threads), "--res", res, "--light-sampler", sampler]
     r0 = os.times()
@@ -151,7 +153,7 @@ def main() -> None:
     a = ap.parse_args()
     if a.seeds < 2:
         ap.error("--seeds must be at least 2 (the error is the variance across seeds)")
-    os.makedirs(OUT, exist_ok=True)
+    os.makedirs(os.path.join(OUT, str(os.getpid())), exist_ok=True)
     cfgs = {c[0]: c for c in (config(spec, a.binary) for spec in a.samplers)}
     labels = list(cfgs)
     cand, others = labels[0], labels[1:]
