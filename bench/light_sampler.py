@@ -27,7 +27,9 @@ elsewhere hits them alike) and measures
 
 A sampler may be given as LABEL=SAMPLER@BINARY to compare binaries: e.g.
 `--samplers bvh bvh-old=bvh@/path/to/old/candela` is the Welch comparison of a changed
-sampler against the previous one, with its variance ratio.
+sampler against the previous one, with its variance ratio; and LABEL=SAMPLER+ARGS (or
+LABEL=SAMPLER@BINARY+ARGS) adds render arguments, e.g. `"power=bvh+--mis power"
+balance=bvh` compares MIS heuristics.
 
 Usage: bench/light_sampler.sh [--spp 16] [--seeds 8] [--size 128] [--threads 2]
                               [--samplers bvh uniform power] [--ipp] [--binary PATH]
@@ -88,20 +90,24 @@ def light_count(binary: str, scene: str) -> int:
 
 
 def config(spec: str, binary: str) -> tuple:
-    """(label, sampler, binary) from SAMPLER or LABEL=SAMPLER@BINARY."""
-    label, _, rest = spec.rpartition("=")
+    """(label, sampler, binary, extra arguments) from SAMPLER or
+    LABEL=SAMPLER[@BINARY][+ARGS]."""
+    label, _, rest = spec.partition("=")
+    if not rest:
+        label, rest = "", label
+    rest, _, args = rest.partition("+")
     sampler, _, other = rest.partition("@")
-    return label or sampler, sampler, other or binary
+    return label or sampler, sampler, other or binary, args.split()
 
 
 def render(cfg: tuple, scene: str, seed: int, res: str, a) -> tuple:
     """One render: its image and the CPU seconds of the whole process."""
-    label, sampler, binary = cfg
+    label, sampler, binary, args = cfg
     # One folder per run (its process id), so that runs side by side do not share files.
     out = os.path.join(OUT, str(os.getpid()),
                        f"{os.path.basename(scene)}_{label}_{seed}.pfm")
     cmd = [binary, "render", scene, "-o", out, "--spp", str(a.spp), "--seed", str(seed),
-           "--threads", str(a.threads), "--res", res, "--light-sampler", sampler]
+           "--threads", str(a.threads), "--res", res, "--light-sampler", sampler] + args
     r0 = os.times()
     candela.run(cmd, cwd=REPO)
     r1 = os.times()
@@ -124,9 +130,9 @@ def welch_fails(x: list, y: list) -> tuple:
 
 
 def ipp(cfg: tuple, scene: str) -> int:
-    _, sampler, binary = cfg
+    _, sampler, binary, args = cfg
     p = subprocess.run([os.path.join(BENCH_DIR, "lanes", "ipp.sh"), binary, scene,
-                        str(IPP_RES), "1", "3", "--light-sampler", sampler],
+                        str(IPP_RES), "1", "3", "--light-sampler", sampler] + args,
                        cwd=REPO, capture_output=True, text=True, check=True)
     return int(p.stdout.strip().splitlines()[-1])
 
@@ -182,7 +188,8 @@ def main() -> None:
             row.append(str(counts[cand]))
         for o in others:
             ratio, se = tile_ratio(tiles[cand], tiles[o], rng, BOOTSTRAP)
-            t_ratio = cpu[cand] / cpu[o]
+            # os.times counts in ticks: a run too short for one has no time ratio.
+            t_ratio = cpu[cand] / cpu[o] if min(cpu[cand], cpu[o]) > 0 else float("nan")
             fails, n_tiles = welch_fails(imgs[cand], imgs[o])
             row += [f"{ratio:.3f} ± {se:.3f}", verdict(ratio, se), f"{t_ratio:.2f}",
                     f"{1.0 / (ratio * t_ratio):.2f}"]
