@@ -39,9 +39,10 @@ pub enum LightSamplerKind {
     /// Resampled importance sampling over candidates from the array.
     Ris,
     /// Light BVH with orientation cones (Conty Estevez & Kulla 2018): the default, since
-    /// at equal spp it measured 0.26–0.72× `Power`'s relMSE where the choice of light
-    /// matters, 0.86× on glossy plates and the same with one light, for 1.0–1.8× the CPU
-    /// time per sample (`bench/equal_spp.sh`, bench/RESULTS.md, issue 36).
+    /// at equal spp it is never worse than `Uniform` or `Power` beyond noise on 22 scenes
+    /// and 0.08–0.79× their variance where the choice of light matters, for 1.0–1.6× the
+    /// instructions per path (one light: the same pick and cost) (`bench/light_sampler.sh`,
+    /// bench/RESULTS.md, light_sampler; issue 36).
     #[default]
     Bvh,
     /// Resampled importance sampling over candidates from the light BVH.

@@ -106,6 +106,57 @@ fn pmfs_sum_to_one_and_match_pick_frequencies() {
     }
 }
 
+/// Trees of at most `FLAT_MAX` lights are sampled flat: each light in proportion to its
+/// own bounds' importance at the point (checked exactly against `LightBounds::importance`),
+/// and the picks follow that pmf (chi-square, 3, 6 and 8 lights at the four points).
+#[test]
+fn small_bvh_picks_each_light_by_its_own_importance() {
+    use candela_core::light_sampler::FLAT_MAX;
+    let all = lights();
+    let sizes = [3, 6, FLAT_MAX];
+    // 12 tests; Šidák-corrected so that the suite falsely fails with probability 1%.
+    let alpha = sidak_alpha(0.01, sizes.len() * contexts().len());
+    for n in sizes {
+        // Every fourth light is a point (which reaches every test point), so each set
+        // has some light that can contribute everywhere.
+        let lights: Vec<Light> = all.iter().skip(1).step_by(2).take(n).cloned().collect();
+        let sampler = LightSampler::new(LightSamplerKind::Bvh, 8, &lights);
+        for (ci, ctx) in contexts().iter().enumerate() {
+            let importance: Vec<f64> = lights
+                .iter()
+                .map(|l| l.bounds().unwrap().importance(ctx) as f64)
+                .collect();
+            let total: f64 = importance.iter().sum();
+            let pmf: Vec<f64> = (0..n as u32)
+                .map(|i| sampler.pmf(ctx, LightId(i)) as f64)
+                .collect();
+            for i in 0..n {
+                let want = importance[i] / total;
+                assert!(
+                    (pmf[i] - want).abs() <= 1e-5 * want.max(1e-3),
+                    "n {n} ctx {ci} light {i}"
+                );
+            }
+            let mut counts = vec![0u64; n];
+            let mut rng = Pcg32::new(29, ci as u64);
+            for _ in 0..SAMPLES {
+                let pick = sampler
+                    .sample(ctx, rng.uniform_f32(), &lights)
+                    .expect("some light reaches every test point");
+                assert_eq!(pick.pmf, sampler.pmf(ctx, pick.id));
+                counts[pick.id.0 as usize] += 1;
+            }
+            let report = discrete(
+                &format!("flat BVH of {n} at ctx {ci}"),
+                &counts,
+                &pmf,
+                alpha,
+            );
+            report.assert_passed();
+        }
+    }
+}
+
 /// The check above has teeth: the BVH's picks at one point tested against its pmf at
 /// another point (a plausible bug: a stale shading context) fail.
 #[test]

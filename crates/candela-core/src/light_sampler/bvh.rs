@@ -2,7 +2,11 @@
 //! binary tree whose nodes carry [`LightBounds`]; sampling descends from the root,
 //! choosing each child in proportion to its importance at the shading point, in
 //! O(log N). The pick probability is the product of the choices along the way, which
-//! [`LightBvh::pmf`] retraces from a per-light bit trail.
+//! [`LightBvh::pmf`] retraces from a per-light bit trail. A tree of at most
+//! [`FLAT_MAX`] lights is not descended: each light is picked by its own bounds'
+//! importance, for about the cost of the descent's two bounds per level (on
+//! `scenes/ies-room.toml`, six lights, 0.74× the descent's variance at equal spp:
+//! bench/RESULTS.md, light_sampler).
 //!
 //! Lights without bounds (infinite lights) are kept apart and picked with probability
 //! n_inf / (n_inf + 1), the tree counting as one more "light" (as pbrt does); among
@@ -25,6 +29,10 @@ const PARALLEL_MIN: usize = 4096;
 const MEDIAN_MAX: usize = 8;
 /// Beyond this depth splits fall back to the median, so that trails fit in 64 bits.
 const MAX_SAOH_DEPTH: u32 = 40;
+/// Trees of at most this many lights are sampled flat: every light by its own importance
+/// at the point, in one pass over the leaves, instead of a descent through clusters whose
+/// bounds blur their members' (see [`LightBvh::sample`]).
+pub const FLAT_MAX: usize = 8;
 
 #[derive(Clone, Copy, Debug)]
 struct Node {
@@ -54,6 +62,9 @@ pub struct LightBvh {
     /// Per light: the branch taken at each level (bit d = level d, 1 = second child),
     /// with a leading 1 marking the depth; 0 where the light is not in the tree.
     trails: Vec<u64>,
+    /// Where the tree has at most [`FLAT_MAX`] lights: its leaves' node indices, which
+    /// sampling weighs directly; empty otherwise.
+    flat: Vec<u32>,
 }
 
 struct Item {
@@ -92,6 +103,7 @@ impl LightBvh {
             infinite,
             infinite_importance,
             trails: vec![0; lights.len()],
+            flat: Vec::new(),
         };
         if !items.is_empty() {
             // A subtree over n lights has exactly 2n − 1 nodes, so every subtree's place in
@@ -114,6 +126,12 @@ impl LightBvh {
                 })
                 .collect();
             bvh.set_trails();
+            // A tree of n lights has 2n − 1 nodes.
+            if bvh.nodes.len() < 2 * FLAT_MAX {
+                bvh.flat = (0..bvh.nodes.len() as u32)
+                    .filter(|&i| bvh.nodes[i as usize].is_leaf)
+                    .collect();
+            }
         }
         Some(bvh)
     }
@@ -154,6 +172,9 @@ impl LightBvh {
             return Some((self.infinite[i], p_inf * p));
         }
         u = ((u - p_inf) / p_tree).min(ONE_MINUS_EPSILON);
+        if !self.flat.is_empty() {
+            return self.sample_flat(ctx, u).map(|(i, p)| (i, p_tree * p));
+        }
         let mut pmf = p_tree;
         let mut at = 0usize;
         loop {
@@ -190,6 +211,9 @@ impl LightBvh {
                 None => 0.0,
             };
         }
+        if !self.flat.is_empty() {
+            return self.p_tree() * self.flat_pmf(ctx, light);
+        }
         let depth = 63 - trail.leading_zeros();
         let mut pmf = self.p_tree();
         let mut at = 0usize;
@@ -214,6 +238,56 @@ impl LightBvh {
             return 0.0;
         }
         pmf
+    }
+
+    /// The importances of the flat tree's leaves at `ctx` (in the order of `flat`) and
+    /// their sum.
+    #[inline]
+    fn flat_weights(&self, ctx: &ShadingCtx) -> ([f32; FLAT_MAX], f32) {
+        let mut w = [0.0f32; FLAT_MAX];
+        let mut total = 0.0;
+        for (w, &leaf) in w.iter_mut().zip(&self.flat) {
+            *w = self.nodes[leaf as usize].bounds.importance(ctx);
+            total += *w;
+        }
+        (w, total)
+    }
+
+    /// A light of a flat tree in proportion to its importance at `ctx`, and its
+    /// probability among the tree's; `None` where none can reach the point. One light
+    /// by its own bounds, where the descent weighs clusters by bounds of their union:
+    /// the same cost up to FLAT_MAX lights (a descent evaluates two bounds per level),
+    /// and picks that follow each light rather than its cluster.
+    fn sample_flat(&self, ctx: &ShadingCtx, u: f32) -> Option<(u32, f32)> {
+        let (w, total) = self.flat_weights(ctx);
+        if total <= 0.0 || !total.is_finite() {
+            return None;
+        }
+        let target = u * total;
+        let mut acc = 0.0;
+        let mut last = None;
+        for (&w, &leaf) in w.iter().zip(&self.flat) {
+            if w > 0.0 {
+                last = Some((self.nodes[leaf as usize].index, w / total));
+                acc += w;
+                if target < acc {
+                    break;
+                }
+            }
+        }
+        last
+    }
+
+    /// Probability that [`Self::sample_flat`] picks `light` at `ctx`.
+    fn flat_pmf(&self, ctx: &ShadingCtx, light: u32) -> f32 {
+        let (w, total) = self.flat_weights(ctx);
+        if total <= 0.0 || !total.is_finite() {
+            return 0.0;
+        }
+        self.flat
+            .iter()
+            .position(|&leaf| self.nodes[leaf as usize].index == light)
+            .map_or(0.0, |k| w[k] / total)
     }
 
     /// The importances of the infinite lights at `ctx` and their sum, or `None` where

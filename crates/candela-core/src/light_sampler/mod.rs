@@ -19,7 +19,7 @@ mod bvh;
 pub mod ris;
 
 pub use array::LightArray;
-pub use bvh::LightBvh;
+pub use bvh::{LightBvh, FLAT_MAX};
 pub use ris::Ris;
 
 use crate::light::{Light, LightId, ShadingCtx};
@@ -41,8 +41,8 @@ pub struct LightPick {
 pub enum LightSampler {
     /// No lights to sample.
     Empty,
-    /// The one light there is, picked with probability 1: what the uniform, power and
-    /// array samplers give for one light, without their arithmetic.
+    /// The one light there is, picked with probability 1: what every sampler gives for
+    /// one light (the BVH and RIS where it can contribute), without their arithmetic.
     Single,
     /// Every light equally likely.
     Uniform { count: u32 },
@@ -67,17 +67,15 @@ impl LightSampler {
             count: lights.len() as u32,
         };
         let powers = || -> Vec<f32> { lights.iter().map(Light::power).collect() };
-        // One light: the uniform sampler, the alias table and the array pick it with
-        // probability exactly 1, which needs no arithmetic (the uniform pick's saturating
-        // float-to-integer conversion and division were 23 of the Cornell box's ~320
-        // instructions a light sample). The BVH and RIS can still refuse a light that
-        // cannot contribute, so they stay what they are.
-        if lights.len() == 1
-            && matches!(
-                kind,
-                LightSamplerKind::Uniform | LightSamplerKind::Power | LightSamplerKind::Array
-            )
-        {
+        // One light: every sampler picks it with probability 1 (the uniform sampler, the
+        // alias table and the array exactly; the BVH and RIS wherever it can contribute),
+        // which needs no arithmetic. The uniform pick's saturating float-to-integer
+        // conversion and division were 23 of the Cornell box's ~320 instructions a light
+        // sample; the BVH's importance at its one leaf, computed for the pick and again for
+        // MIS, cost more (bench/RESULTS.md, light_sampler). Where the BVH would have refused
+        // the light (its bounds say it cannot reach the point), the light's own sample or
+        // the BSDF gives zero before any shadow ray, so the estimate is the same.
+        if lights.len() == 1 {
             return LightSampler::Single;
         }
         // Where no power can be estimated (zero everywhere), every sampler falls back to
@@ -155,7 +153,7 @@ mod tests {
     use crate::light::ParallelogramLight;
 
     #[test]
-    fn one_light_is_picked_with_probability_one_by_the_uniform_and_power_samplers() {
+    fn one_light_is_picked_with_probability_one_by_every_sampler() {
         let lamp = ParallelogramLight::new(Vec3::ZERO, Vec3::X, Vec3::Z, -Vec3::Y, Vec3::ONE)
             .map(Light::Parallelogram)
             .unwrap();
@@ -172,8 +170,12 @@ mod tests {
             LightSamplerKind::Uniform,
             LightSamplerKind::Power,
             LightSamplerKind::Array,
+            LightSamplerKind::Bvh,
+            LightSamplerKind::Ris,
+            LightSamplerKind::RisBvh,
         ] {
-            let s = LightSampler::new(kind, 1, &lights);
+            let s = LightSampler::new(kind, 4, &lights);
+            assert!(matches!(s, LightSampler::Single), "{kind:?}");
             for u in [0.0, 0.3, 0.999_999] {
                 let pick = s.sample(&ctx, u, &lights).unwrap();
                 assert_eq!(pick.id, LightId(0));
