@@ -306,7 +306,7 @@ fn rays_bench(scene: &str, out: &Path, n_rays: usize) {
         f.write_all(&t.to_le_bytes()).unwrap();
     }
     let packets = packet_mode()
-        .map(|mode| packet_bench(&accel, &rays, &hits, mode))
+        .map(|mode| packet_bench(&accel, &rays, &hits, &camera, mode))
         .unwrap_or_default();
     let n = rays.len() as f64;
     let (node_bytes, block_bytes) = accel.memory();
@@ -329,6 +329,13 @@ fn rays_bench(scene: &str, out: &Path, n_rays: usize) {
 /// (`--toggle-collect=traversal::trace_closest`).
 #[inline(never)]
 fn trace_closest(accel: &Accel, rays: &[Ray], hits: &mut [(u32, f32)]) {
+    closest_loop(accel, rays, hits)
+}
+
+/// The body of [`trace_closest`] and [`trace_primary`] (inlined into each, so that each
+/// counts only its own rays).
+#[inline(always)]
+fn closest_loop(accel: &Accel, rays: &[Ray], hits: &mut [(u32, f32)]) {
     for (r, h) in rays.iter().zip(hits.iter_mut()) {
         if let Some(hit) = accel.intersect(r, f32::INFINITY, leaf_mask) {
             *h = (hit.prim, hit.t);
@@ -382,11 +389,47 @@ fn packet_mode() -> Option<PacketMode> {
 
 /// Packets of eight against single rays, in `mode`: closest hit and any hit on the bounce rays,
 /// any hit on shadow rays, eight consecutive rays a packet (incoherent: each from a
-/// random pixel). Checks that every any-hit answer and every closest-hit distance is the
+/// random pixel); and closest hit on coherent primary rays, a packet from a 4 × 2 pixel
+/// tile of a 512² image (tiles spread evenly over it). Checks that every any-hit answer and every closest-hit distance is the
 /// single rays' (and counts the closest hits on another primitive at the same distance),
 /// and returns the JSON fields.
-fn packet_bench(accel: &Accel, rays: &[Ray], hits: &[(u32, f32)], mode: PacketMode) -> String {
+fn packet_bench(
+    accel: &Accel,
+    rays: &[Ray],
+    hits: &[(u32, f32)],
+    camera: &CameraFn,
+    mode: PacketMode,
+) -> String {
     let k = mode.single_below;
+    let mut rng = Pcg32::new(5, 3);
+    let primary: Vec<Ray> = (0..rays.len())
+        .map(|i| {
+            // Tiles spread evenly over the 128 × 256 tiles of the image.
+            let step = (128 * 256 / (rays.len() / 8).max(1)).max(1);
+            let (tile, j) = (i / 8 * step % (128 * 256), i % 8);
+            let (x, y) = ((tile % 128) * 4 + j % 4, (tile / 128) % 256 * 2 + j / 4);
+            let film = Vec2::new(x as f32 + rng.uniform_f32(), y as f32 + rng.uniform_f32());
+            camera(film / 512.0)
+        })
+        .collect();
+    let mut primary_hits = vec![(u32::MAX, f32::INFINITY); rays.len()];
+    let mut primary_hit = 0;
+    let primary1 = best_of(3, || {
+        primary_hit = trace_primary(accel, &primary, &mut primary_hits)
+    });
+    let mut primary_hits8 = vec![(u32::MAX, f32::INFINITY); rays.len()];
+    let mut primary_hit8 = 0;
+    let primary8 = best_of(3, || {
+        primary_hit8 = trace_primary8(accel, &primary, &mut primary_hits8, mode)
+    });
+    assert_eq!(primary_hit, primary_hit8, "primary rays that hit");
+    for (i, (a, b)) in primary_hits.iter().zip(&primary_hits8).enumerate() {
+        assert_eq!(
+            a.1.to_bits(),
+            b.1.to_bits(),
+            "primary ray {i}: packet distance"
+        );
+    }
     let (shadow, shadow_t) = shadow_rays(accel, rays);
     let mut hits8 = vec![(u32::MAX, f32::INFINITY); rays.len()];
     let closest8 = best_of(3, || trace_closest8(accel, rays, &mut hits8, mode));
@@ -421,18 +464,42 @@ fn packet_bench(accel: &Accel, rays: &[Ray], hits: &[(u32, f32)], mode: PacketMo
     format!(
         ", \"packet_k\": {k}, \"packet_box_against_rays\": {}, \"closest8_mrays_s\": {:.3}, \"any8_mrays_s\": {:.3}, \
          \"shadow_mrays_s\": {:.3}, \"shadow8_mrays_s\": {:.3}, \"shadow_blocked\": \
-         {shadow_blocked}, \"closest8_other_prim\": {other_prim}",
+         {shadow_blocked}, \"closest8_other_prim\": {other_prim}, \"primary_mrays_s\": \
+         {:.3}, \"primary8_mrays_s\": {:.3}",
         mode.box_against_rays,
         n / closest8 / 1e6,
         n / any8 / 1e6,
         n / shadow1 / 1e6,
-        n / shadow8 / 1e6
+        n / shadow8 / 1e6,
+        n / primary1 / 1e6,
+        n / primary8 / 1e6
     )
+}
+
+/// Primary rays one at a time (`traversal::trace_primary`): how many hit. (Not the same
+/// code as [`trace_closest`], which the linker would fold into one symbol.)
+#[inline(never)]
+fn trace_primary(accel: &Accel, rays: &[Ray], hits: &mut [(u32, f32)]) -> usize {
+    closest_loop(accel, rays, hits);
+    hits.iter().filter(|h| h.0 != u32::MAX).count()
+}
+
+/// Primary rays eight a call (`traversal::trace_primary8`): how many hit.
+#[inline(never)]
+fn trace_primary8(accel: &Accel, rays: &[Ray], hits: &mut [(u32, f32)], mode: PacketMode) -> usize {
+    closest8_loop(accel, rays, hits, mode);
+    hits.iter().filter(|h| h.0 != u32::MAX).count()
 }
 
 /// [`trace_closest`] eight rays a call (`traversal::trace_closest8`).
 #[inline(never)]
 fn trace_closest8(accel: &Accel, rays: &[Ray], hits: &mut [(u32, f32)], mode: PacketMode) {
+    closest8_loop(accel, rays, hits, mode)
+}
+
+/// The body of [`trace_closest8`] and [`trace_primary8`].
+#[inline(always)]
+fn closest8_loop(accel: &Accel, rays: &[Ray], hits: &mut [(u32, f32)], mode: PacketMode) {
     for (r, h) in rays.chunks_exact(8).zip(hits.chunks_exact_mut(8)) {
         let found = accel.intersect8(r.try_into().unwrap(), &[f32::INFINITY; 8], mode, leaf_mask);
         for (f, h) in found.iter().zip(h) {

@@ -1,8 +1,8 @@
 //! Queries of eight rays at once: the packet traversal of [`crate::bvh::RayPacket`] over
 //! the scene's tree, each leaf tested for one ray at a time by the single-ray block test.
-//! A measured kernel for `bench/traversal.sh` (issue #35's packet rung), not used by the
-//! renderer: on incoherent rays it costs more than eight single-ray queries (figures in
-//! `bench/README.md`, "Packets of eight rays").
+//! A measured kernel for the `traversal` benchmark (issue #35's packet rung), not used by
+//! the renderer: on incoherent rays it costs more than eight single-ray queries, on
+//! coherent camera rays about 10 % less (figures in `bench/RESULTS.md`, `## traversal`).
 
 use std::cell::Cell;
 

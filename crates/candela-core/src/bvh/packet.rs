@@ -10,9 +10,10 @@
 //! 2012, "Combining Single and Packet-Ray Tracing"): on incoherent rays few lanes stay
 //! together below the root's levels.
 //!
-//! `bench/traversal.sh` measures it against eight single-ray queries on the same rays
-//! (`bench/README.md`, "Packets of eight rays"); on this machine's incoherent bounce and
-//! shadow rays it loses, which is why the renderer traces single rays.
+//! The `traversal` benchmark measures it against eight single-ray queries on the same
+//! rays (`bench/README.md`, "Packets of eight rays"): on incoherent bounce and shadow rays
+//! it costs more instructions than single rays, which is why the renderer traces single
+//! rays; on coherent primary rays (4 × 2 pixel tiles) it saves about 10 %.
 
 #![cfg(target_arch = "x86_64")]
 
