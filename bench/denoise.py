@@ -1,7 +1,8 @@
-"""Denoising benchmark (issue #38): on the Cornell box and two other bundled scenes, a
-16-spp render denoised by Intel Open Image Denoise (`candela render --denoise`, guided
-by the albedo and normal passes, and `--denoise=color`, the beauty alone) against the raw
-16- and 256-spp renders, each compared with a 4096-spp reference of the same scene.
+"""Denoising benchmark (issue #38): on the Cornell box and other bundled scenes, a 16-spp
+render denoised by Intel Open Image Denoise (`candela render --denoise`, guided by the
+albedo and normal passes, and `--denoise=color`, the beauty alone) against the raw 16-
+and 256-spp renders, each compared with a reference of the same scene (4096 spp unless
+--ref-spp).
 
 Errors: relMSE with the worst 1 % of pixels dropped (per-pixel relMSE, mean over the
 channels, ε = 1e-2; a denoiser rightly softens the edges of directly seen lamps, which
@@ -31,11 +32,17 @@ from benchlib import machine, report  # noqa: E402
 from benchlib.images import RELMSE_EPS, read_pfm  # noqa: E402
 
 REPO = os.path.dirname(here)
-# The Cornell box and two other bundled scenes, at their own resolutions unless --scale.
+# Bundled scenes at their own resolutions (--scale for a fraction): the Cornell box, the
+# glass sphere and the plastics by default, the others by --scenes.
 SCENES = [
     ("scenes/cornell.toml", (512, 512)),
     ("scenes/glass_sphere.toml", (320, 240)),
     ("scenes/plastics.toml", (480, 160)),
+    ("scenes/textured-light.toml", (480, 270)),
+    ("scenes/many_lights.toml", (400, 300)),
+    ("scenes/ies-room.toml", (480, 320)),
+    ("scenes/environment.toml", (480, 270)),
+    ("scenes/media.toml", (320, 240)),
 ]
 SUMMARY = re.compile(r"(\d+)x(\d+), (\d+) spp, ([\d.]+) s,")
 PASSES = re.compile(r"passes [a-z, ]+ in ([\d.]+) s")
@@ -93,7 +100,8 @@ def main():
     ap.add_argument("--threads", type=int, default=0,
                     help="candela's threads (default: all cores)")
     ap.add_argument("--scenes", default="cornell,glass_sphere,plastics",
-                    help="comma-separated names of the scenes to run, in order")
+                    help="comma-separated names of the scenes to run, in order: "
+                         + ", ".join(name_of(scene) for scene, _ in SCENES))
     a = ap.parse_args()
     os.makedirs(a.out, exist_ok=True)
     info = machine.describe(REPO)

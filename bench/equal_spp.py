@@ -8,7 +8,12 @@ each renderer's relMSE against the reference averaged over the seeds (also with 
 worst 0.1 % of pixels dropped, for scenes ruled by rare bright paths), its ratio to
 Mitsuba's, and CPU time per sample (user + system of all threads, over pixels × spp;
 Mitsuba's from a second, warm render, so JIT compilation is left out; Candela's is the
-whole process, loading included).
+whole process, loading included). For issue 35's speed targets it also prints the render
+wall time per sample (Mitsuba's warm render; Candela's render time from its summary line,
+loading and the BVH build left out, as Mitsuba's warm render leaves them out), its ratio
+to Mitsuba's, and the time-to-equal-error lead, Mitsuba's time × relMSE ÷ Candela's (by
+the relMSE with the worst 0.1 % dropped, which rare fireflies do not rule), with the
+geometric mean over scenes of each Candela configuration.
 
 Usage: bench/equal_spp.sh [--scenes a.xml b.xml] [--spp 64] [--res 128] [--seeds 1 2 3 4]
 """
@@ -31,6 +36,7 @@ OUT = os.path.join(BENCH_DIR, "out", "equal_spp")
 CANDELA = os.path.join(REPO, "target", "release", "candela")
 REF_SEED = 100_000
 REF_PASS_SPP = 256
+MITSUBA = "Mitsuba 3 llvm_ad_rgb"
 
 
 def trimmed_relmse(x: np.ndarray, ref: np.ndarray, drop: float = 0.001) -> float:
@@ -74,10 +80,11 @@ def main() -> None:
     os.makedirs(OUT, exist_ok=True)
     samples = a.res * a.res * a.spp
     rows = []
+    leads = {}  # Candela configuration -> list of (time ratio, lead), a scene each
     for scene in map(os.path.abspath, a.scenes):
         name = os.path.splitext(os.path.basename(scene))[0]
         ref = reference(scene, a)
-        errs = {}  # renderer -> list of (relmse, trimmed, cpu ns per sample)
+        errs = {}  # renderer -> list of (relmse, trimmed, cpu ns, wall ns per sample)
         for seed in a.seeds:
             out = os.path.join(OUT, f"{name}-mitsuba-{seed}.exr")
             r = mitsuba_render.run(scene, out, variant="llvm_ad_rgb", threads=a.threads,
@@ -85,32 +92,44 @@ def main() -> None:
                                    warm_runs=1)
             img = images.load_exr(out)
             ns = r["warm"][0]["cpu_s"] / samples * 1e9
-            errs.setdefault("Mitsuba 3 llvm_ad_rgb", []).append(
-                (images.relmse(img, ref), trimmed_relmse(img, ref), ns))
+            wall_ns = r["warm"][0]["wall_s"] / samples * 1e9
+            errs.setdefault(MITSUBA, []).append(
+                (images.relmse(img, ref), trimmed_relmse(img, ref), ns, wall_ns))
             for cname, args in configs:
                 out = os.path.join(OUT, f"{name}-candela-{cname}-{seed}.pfm")
                 cmd = [CANDELA, "render", scene, "-o", out, "--spp", str(a.spp),
                        "--seed", str(seed), "--threads", str(a.threads),
                        "-D", f"res={a.res}"] + args.split()
                 c0 = children_cpu_s()
-                candela.run(cmd)
+                m = candela.run(cmd)
                 ns = (children_cpu_s() - c0) / samples * 1e9
+                wall_ns = float(m["secs"]) / samples * 1e9
                 img = images.read_pfm(out)
                 errs.setdefault(f"Candela {cname}", []).append(
-                    (images.relmse(img, ref), trimmed_relmse(img, ref), ns))
-        base = np.mean([e[0] for e in errs["Mitsuba 3 llvm_ad_rgb"]])
-        base_t = np.mean([e[1] for e in errs["Mitsuba 3 llvm_ad_rgb"]])
+                    (images.relmse(img, ref), trimmed_relmse(img, ref), ns, wall_ns))
+        base, base_t, _, base_wall = (np.mean([x[i] for x in errs[MITSUBA]]) for i in range(4))
         for who, e in errs.items():
-            m, t, ns = (np.mean([x[i] for x in e]) for i in range(3))
+            m, t, ns, wall = (np.mean([x[i] for x in e]) for i in range(4))
+            lead = (base_wall * base_t) / (wall * t)
+            if who != MITSUBA:
+                leads.setdefault(who, []).append((wall / base_wall, lead))
             rows.append([name, who, report.fmt(m, 5), report.fmt(m / base, 3),
-                         report.fmt(t, 5), report.fmt(t / base_t, 3), report.fmt(ns, 0)])
+                         report.fmt(t, 5), report.fmt(t / base_t, 3), report.fmt(ns, 0),
+                         report.fmt(wall, 0), report.fmt(wall / base_wall, 3),
+                         report.fmt(lead, 3)])
             print("|".join(str(c) for c in rows[-1]), flush=True)
     header = ["scene", "renderer", "relMSE", "÷ Mitsuba", "relMSE −0.1 %", "÷ Mitsuba",
-              "CPU ns/sample"]
+              "CPU ns/sample", "render ns/sample", "time ÷ Mitsuba", "lead"]
     info = machine.describe(REPO)
     print(f"\n{a.res}×{a.res}, {a.spp} spp, seeds {a.seeds}, reference {a.ref_variant} "
           f"{a.ref_spp} spp; {info}\n")
-    print(report.table(header, rows, "llrrrrr"))
+    print(report.table(header, rows, "llrrrrrrrr"))
+    for who, v in leads.items():
+        ratio, lead = np.array(v).T
+        print(f"\n{who}: render time per sample ÷ Mitsuba's, geometric mean "
+              f"{np.exp(np.log(ratio).mean()):.3f} (worst {ratio.max():.3f}); "
+              f"time-to-equal-error lead (−0.1 %), geometric mean "
+              f"{np.exp(np.log(lead).mean()):.3f}")
 
 
 if __name__ == "__main__":

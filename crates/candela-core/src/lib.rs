@@ -36,6 +36,7 @@ pub mod integrator;
 pub mod isa;
 pub mod light;
 pub mod light_sampler;
+pub mod limb_sums;
 pub mod material;
 pub mod math;
 pub mod medium;

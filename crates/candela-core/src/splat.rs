@@ -11,6 +11,11 @@
 //! then added into the film one after another in the order of their bands. So every pixel
 //! sums the same numbers in the same order whatever the thread count or the order in
 //! which the bands ran.
+//!
+//! Cost: a Gaussian of radius 2 spreads a sample over 16 pixels, four exact sums each.
+//! A block therefore collects its shares in [`LimbSums`] (in the v3 copy of the render
+//! loop, one pixel's four shares at a time in AVX2) and folds them into its pixels when
+//! its band is done: integer sums, so the same bits as adding each share to the pixel.
 
 use std::ops::Range;
 use std::sync::atomic::Ordering;
@@ -21,6 +26,8 @@ use rayon::prelude::*;
 use crate::film::{Film, Pixel};
 use crate::filter::PixelFilter;
 use crate::integrator::{render_band, Band, PassCtx, RenderStats, SampleSink};
+use crate::limb_sums::LimbSums;
+use crate::options::Isa;
 use crate::sampler::Sampler;
 
 /// Rows of samples per work item; its block holds the apron besides.
@@ -36,6 +43,9 @@ pub(crate) fn render_pass<S: Sampler>(
     let (w, h) = (film.width, film.height);
     let filter = &ctx.scene.filter;
     let apron = apron_rows(filter.radius());
+    // A pixel takes at most one share of each sample within the apron's reach per axis.
+    let reach = 2 * apron as u64 + 1;
+    let limbs = reach * reach * pass.len() as u64 <= LimbSums::CAPACITY;
     let bands: Vec<Range<u32>> = (0..h)
         .step_by(BAND_ROWS as usize)
         .map(|y0| y0..(y0 + BAND_ROWS).min(h))
@@ -45,12 +55,15 @@ pub(crate) fn render_pass<S: Sampler>(
         .map(|rows| {
             let y0 = rows.start.saturating_sub(apron);
             let y1 = (rows.end + apron).min(h);
+            let len = (w * (y1 - y0)) as usize;
             let mut block = SplatBlock {
                 filter,
                 width: w,
                 height: h,
                 y0,
-                pixels: vec![Pixel::default(); (w * (y1 - y0)) as usize],
+                pixels: vec![Pixel::default(); len],
+                limbs: vec![LimbSums::default(); if limbs { len } else { 0 }],
+                isa: ctx.isa,
             };
             if ctx.cancel.load(Ordering::Relaxed) {
                 return (block, RenderStats::default());
@@ -63,6 +76,10 @@ pub(crate) fn render_pass<S: Sampler>(
             };
             let mut sampler = sampler.clone();
             let stats = render_band(ctx.scene, ctx.isa, &mut sampler, band, &mut block);
+            for (sums, pixel) in block.limbs.iter_mut().zip(&mut block.pixels) {
+                sums.fold_into(pixel);
+            }
+            block.limbs = Vec::new();
             (ctx.progress)(done);
             (block, stats)
         })
@@ -102,11 +119,19 @@ struct SplatBlock<'a> {
     height: u32,
     y0: u32,
     pixels: Vec<Pixel>,
+    /// Shares pending for `pixels` (empty where a pass could exceed their capacity: the
+    /// shares then go to the pixels directly).
+    limbs: Vec<LimbSums>,
+    /// The render loop's copy, which says whether the shares are added in AVX2.
+    isa: Isa,
 }
 
 impl SampleSink for SplatBlock<'_> {
     const SPLATS: bool = true;
 
+    /// Inlined into each copy of the render loop: in the v3 copy its floors and ceilings
+    /// are single instructions and the AVX2 row is inlined, not called.
+    #[inline(always)]
     fn add(&mut self, p: UVec2, film_pos: Vec2, l: Vec3) {
         let row = |y: u32| ((y - self.y0) * self.width) as usize;
         if !self.pixels[row(p.y) + p.x as usize].count(l) {
@@ -116,29 +141,64 @@ impl SampleSink for SplatBlock<'_> {
         let xs = footprint(film_pos.x, r, self.width);
         // At most 2⌈r⌉ + 1 weights per axis; a wider filter is computed per pixel.
         let mut wx = [0.0f32; 16];
-        let cached = xs.len() <= wx.len();
-        if cached {
-            for (w, x) in wx.iter_mut().zip(xs.clone()) {
-                *w = self.filter.eval_axis(x as f32 + 0.5 - film_pos.x);
-            }
+        if xs.len() > wx.len() || self.limbs.is_empty() {
+            return self.add_per_pixel(film_pos, l);
+        }
+        let wx = &mut wx[..xs.len()];
+        for (w, x) in wx.iter_mut().zip(xs.clone()) {
+            *w = self.filter.eval_axis(x as f32 + 0.5 - film_pos.x);
         }
         for y in footprint(film_pos.y, r, self.height) {
             let wy = self.filter.eval_axis(y as f32 + 0.5 - film_pos.y);
             if wy == 0.0 {
                 continue;
             }
-            let start = row(y);
-            for (i, x) in xs.clone().enumerate() {
-                let wx = if cached {
-                    wx[i]
-                } else {
-                    self.filter.eval_axis(x as f32 + 0.5 - film_pos.x)
-                };
+            let start = row(y) + xs.start as usize;
+            let sums = &mut self.limbs[start..start + xs.len()];
+            match self.isa {
+                // SAFETY: the render loop runs its v3 copy only where the CPU has it.
+                #[cfg(target_arch = "x86_64")]
+                Isa::V3 => unsafe { add_row_avx2(sums, l, wx, wy) },
+                // A zero weight adds nothing: its shares are zero.
+                _ => {
+                    for (s, &wx) in sums.iter_mut().zip(wx.iter()) {
+                        s.add_weighted(l, wx * wy);
+                    }
+                }
+            }
+        }
+    }
+}
+
+impl SplatBlock<'_> {
+    /// [`SampleSink::add`]'s shares straight into the pixels, each filter weight computed
+    /// where it is used: for filters too wide for the per-axis cache and the limbs.
+    fn add_per_pixel(&mut self, film_pos: Vec2, l: Vec3) {
+        let r = self.filter.radius();
+        let xs = footprint(film_pos.x, r, self.width);
+        for y in footprint(film_pos.y, r, self.height) {
+            let wy = self.filter.eval_axis(y as f32 + 0.5 - film_pos.y);
+            if wy == 0.0 {
+                continue;
+            }
+            let start = ((y - self.y0) * self.width) as usize;
+            for x in xs.clone() {
+                let wx = self.filter.eval_axis(x as f32 + 0.5 - film_pos.x);
                 if wx != 0.0 {
                     self.pixels[start + x as usize].add_weighted(l, wx * wy);
                 }
             }
         }
+    }
+}
+
+/// One row of a sample's shares, `l` × `wx[i]` × `wy` into `sums[i]`, in AVX2.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx,avx2")]
+fn add_row_avx2(sums: &mut [LimbSums], l: Vec3, wx: &[f32], wy: f32) {
+    let rgb1 = crate::limb_sums::rgb1(l);
+    for (s, &wx) in sums.iter_mut().zip(wx) {
+        crate::limb_sums::add_weighted_avx2(s, rgb1, wx * wy);
     }
 }
 

@@ -1,6 +1,6 @@
 //! The two compiled copies of the render loop (`candela_core::isa`) render the same films,
 //! bit for bit: every example scene (every BSDF, light kind, texture, the thin lens, the
-//! environment, the light BVH, a glTF file) rendered small with each copy the CPU has.
+//! environment, the light BVH, a glTF file, a splatted filter) rendered small with each copy the CPU has.
 //!
 //! Bit equality is the right test, not a statistical one: both copies run the same
 //! source with the same samples, and without `mul_add` or fast-math the compiler may
@@ -46,7 +46,7 @@ fn film_bits(file: &str, isa: Isa) -> (Vec<i128>, u64) {
     (bits, result.stats.rays)
 }
 
-const SCENES: [&str; 13] = [
+const SCENES: [&str; 14] = [
     "cornell.toml",
     "glass_sphere.toml",
     "rough_metals.toml",
@@ -60,6 +60,8 @@ const SCENES: [&str; 13] = [
     "environment.toml",
     "many_lights.toml",
     "gltf/spheres.gltf",
+    // A thin lens and a splatted Gaussian filter (the splat's AVX2 shares).
+    "../bench/scenes/thin-lens.xml",
 ];
 
 #[test]

@@ -120,6 +120,7 @@ pub(super) fn triangle_interaction(
 }
 
 /// [`triangle_interaction`] with every vertex attribute the mesh has interpolated.
+#[inline]
 fn full_triangle_interaction(
     m: &Mesh,
     inst: Option<&Instance>,
