@@ -27,7 +27,7 @@ use std::path::Path;
 use std::time::Instant;
 
 use candela_bench::cpu_seconds;
-use candela_core::accel::{Accel, AccelLayout, LeafLayout, NodeLayout, Shape, Simd};
+use candela_core::accel::{Accel, AccelLayout, LeafLayout, NodeLayout, PacketMode, Shape, Simd};
 use candela_core::geometry::{Ray, TriangleHit};
 use candela_core::math::{offset_ray_origin, Frame};
 use candela_core::sampler::Pcg32;
@@ -305,6 +305,9 @@ fn rays_bench(scene: &str, out: &Path, n_rays: usize) {
         f.write_all(&prim.to_le_bytes()).unwrap();
         f.write_all(&t.to_le_bytes()).unwrap();
     }
+    let packets = packet_mode()
+        .map(|mode| packet_bench(&accel, &rays, &hits, &camera, mode))
+        .unwrap_or_default();
     let n = rays.len() as f64;
     let (node_bytes, block_bytes) = accel.memory();
     let masked_count = (0..shapes.len() as u32).filter(|&i| filtered(i)).count();
@@ -312,7 +315,7 @@ fn rays_bench(scene: &str, out: &Path, n_rays: usize) {
         "{{\"scene\": \"{scene}\", \"simd\": \"{:?}\", \"layout\": \"{:?}\", \"triangles\": {}, \
          \"spheres\": {spheres}, \"masked\": {masked_count}, \"rays\": {}, \"hit\": {found}, \
          \"build_s\": {build_s:.4}, \"closest_mrays_s\": {:.3}, \"any_mrays_s\": {:.3}, \
-         \"node_bytes\": {node_bytes}, \"block_bytes\": {block_bytes}}}",
+         \"node_bytes\": {node_bytes}, \"block_bytes\": {block_bytes}{packets}}}",
         accel.simd(),
         accel.layout(),
         tris.len(),
@@ -326,6 +329,13 @@ fn rays_bench(scene: &str, out: &Path, n_rays: usize) {
 /// (`--toggle-collect=traversal::trace_closest`).
 #[inline(never)]
 fn trace_closest(accel: &Accel, rays: &[Ray], hits: &mut [(u32, f32)]) {
+    closest_loop(accel, rays, hits)
+}
+
+/// The body of [`trace_closest`] and [`trace_primary`] (inlined into each, so that each
+/// counts only its own rays).
+#[inline(always)]
+fn closest_loop(accel: &Accel, rays: &[Ray], hits: &mut [(u32, f32)]) {
     for (r, h) in rays.iter().zip(hits.iter_mut()) {
         if let Some(hit) = accel.intersect(r, f32::INFINITY, leaf_mask) {
             *h = (hit.prim, hit.t);
@@ -339,6 +349,201 @@ fn trace_any(accel: &Accel, rays: &[Ray]) -> usize {
     rays.iter()
         .filter(|r| accel.occluded(r, f32::INFINITY, leaf_mask))
         .count()
+}
+
+/// Shadow rays: from each bounce ray's origin to a random point on a quad just under the
+/// scene's ceiling (a fifth of its width and depth, centred), `t_max` just short of it.
+fn shadow_rays(accel: &Accel, rays: &[Ray]) -> (Vec<Ray>, Vec<f32>) {
+    let b = accel.bounds();
+    let (c, e) = ((b.min + b.max) * 0.5, b.max - b.min);
+    let mut rng = Pcg32::new(11, 5);
+    rays.iter()
+        .map(|r| {
+            let q = Vec3::new(
+                c.x + 0.2 * e.x * (rng.uniform_f32() - 0.5),
+                b.max.y - 0.01 * e.y,
+                c.z + 0.2 * e.z * (rng.uniform_f32() - 0.5),
+            );
+            let d = q - r.o;
+            let dist = d.length();
+            (Ray::new(r.o, d / dist), dist * 0.999)
+        })
+        .unzip()
+}
+
+/// `CANDELA_PACKET_K=K` (a subtree reached by K rays or fewer is finished by each alone)
+/// and `CANDELA_PACKET_NODES=boxes|rays` (each child box against the rays in lanes, the
+/// default, or each ray against the node's boxes): the packet benchmark's mode, if asked.
+fn packet_mode() -> Option<PacketMode> {
+    let k = std::env::var("CANDELA_PACKET_K").ok()?;
+    let box_against_rays = match std::env::var("CANDELA_PACKET_NODES").as_deref() {
+        Ok("boxes") | Err(_) => true,
+        Ok("rays") => false,
+        Ok(other) => panic!("CANDELA_PACKET_NODES={other:?}: boxes or rays"),
+    };
+    Some(PacketMode {
+        box_against_rays,
+        single_below: k.parse().expect("CANDELA_PACKET_K"),
+    })
+}
+
+/// Packets of eight against single rays, in `mode`: closest hit and any hit on the bounce rays,
+/// any hit on shadow rays, eight consecutive rays a packet (incoherent: each from a
+/// random pixel); and closest hit on coherent primary rays, a packet from a 4 × 2 pixel
+/// tile of a 512² image (tiles spread evenly over it). Checks that every any-hit answer and every closest-hit distance is the
+/// single rays' (and counts the closest hits on another primitive at the same distance),
+/// and returns the JSON fields.
+fn packet_bench(
+    accel: &Accel,
+    rays: &[Ray],
+    hits: &[(u32, f32)],
+    camera: &CameraFn,
+    mode: PacketMode,
+) -> String {
+    let k = mode.single_below;
+    let mut rng = Pcg32::new(5, 3);
+    let primary: Vec<Ray> = (0..rays.len())
+        .map(|i| {
+            // Tiles spread evenly over the 128 × 256 tiles of the image.
+            let step = (128 * 256 / (rays.len() / 8).max(1)).max(1);
+            let (tile, j) = (i / 8 * step % (128 * 256), i % 8);
+            let (x, y) = ((tile % 128) * 4 + j % 4, (tile / 128) % 256 * 2 + j / 4);
+            let film = Vec2::new(x as f32 + rng.uniform_f32(), y as f32 + rng.uniform_f32());
+            camera(film / 512.0)
+        })
+        .collect();
+    let mut primary_hits = vec![(u32::MAX, f32::INFINITY); rays.len()];
+    let mut primary_hit = 0;
+    let primary1 = best_of(3, || {
+        primary_hit = trace_primary(accel, &primary, &mut primary_hits)
+    });
+    let mut primary_hits8 = vec![(u32::MAX, f32::INFINITY); rays.len()];
+    let mut primary_hit8 = 0;
+    let primary8 = best_of(3, || {
+        primary_hit8 = trace_primary8(accel, &primary, &mut primary_hits8, mode)
+    });
+    assert_eq!(primary_hit, primary_hit8, "primary rays that hit");
+    for (i, (a, b)) in primary_hits.iter().zip(&primary_hits8).enumerate() {
+        assert_eq!(
+            a.1.to_bits(),
+            b.1.to_bits(),
+            "primary ray {i}: packet distance"
+        );
+    }
+    let (shadow, shadow_t) = shadow_rays(accel, rays);
+    let mut hits8 = vec![(u32::MAX, f32::INFINITY); rays.len()];
+    let closest8 = best_of(3, || trace_closest8(accel, rays, &mut hits8, mode));
+    let mut blocked8 = Vec::new();
+    let any8 = best_of(3, || {
+        blocked8 = trace_any8(accel, rays, &[f32::INFINITY; 8], mode)
+    });
+    let mut blocked_shadow = Vec::new();
+    let shadow1 = best_of(3, || {
+        blocked_shadow = trace_shadow(accel, &shadow, &shadow_t)
+    });
+    let mut blocked_shadow8 = Vec::new();
+    let shadow8 = best_of(3, || {
+        blocked_shadow8 = trace_shadow8(accel, &shadow, &shadow_t, mode)
+    });
+    let blocked: Vec<bool> = hits.iter().map(|h| h.0 != u32::MAX).collect();
+    assert_eq!(blocked8, blocked, "packet any-hit answers as single rays");
+    assert_eq!(
+        blocked_shadow8, blocked_shadow,
+        "packet shadow rays as single"
+    );
+    for (i, (a, b)) in hits.iter().zip(&hits8).enumerate() {
+        assert_eq!(
+            a.1.to_bits(),
+            b.1.to_bits(),
+            "ray {i}: packet closest distance"
+        );
+    }
+    let other_prim = hits.iter().zip(&hits8).filter(|(a, b)| a.0 != b.0).count();
+    let n = rays.len() as f64;
+    let shadow_blocked = blocked_shadow.iter().filter(|&&b| b).count();
+    format!(
+        ", \"packet_k\": {k}, \"packet_box_against_rays\": {}, \"closest8_mrays_s\": {:.3}, \"any8_mrays_s\": {:.3}, \
+         \"shadow_mrays_s\": {:.3}, \"shadow8_mrays_s\": {:.3}, \"shadow_blocked\": \
+         {shadow_blocked}, \"closest8_other_prim\": {other_prim}, \"primary_mrays_s\": \
+         {:.3}, \"primary8_mrays_s\": {:.3}",
+        mode.box_against_rays,
+        n / closest8 / 1e6,
+        n / any8 / 1e6,
+        n / shadow1 / 1e6,
+        n / shadow8 / 1e6,
+        n / primary1 / 1e6,
+        n / primary8 / 1e6
+    )
+}
+
+/// Primary rays one at a time (`traversal::trace_primary`): how many hit. (Not the same
+/// code as [`trace_closest`], which the linker would fold into one symbol.)
+#[inline(never)]
+fn trace_primary(accel: &Accel, rays: &[Ray], hits: &mut [(u32, f32)]) -> usize {
+    closest_loop(accel, rays, hits);
+    hits.iter().filter(|h| h.0 != u32::MAX).count()
+}
+
+/// Primary rays eight a call (`traversal::trace_primary8`): how many hit.
+#[inline(never)]
+fn trace_primary8(accel: &Accel, rays: &[Ray], hits: &mut [(u32, f32)], mode: PacketMode) -> usize {
+    closest8_loop(accel, rays, hits, mode);
+    hits.iter().filter(|h| h.0 != u32::MAX).count()
+}
+
+/// [`trace_closest`] eight rays a call (`traversal::trace_closest8`).
+#[inline(never)]
+fn trace_closest8(accel: &Accel, rays: &[Ray], hits: &mut [(u32, f32)], mode: PacketMode) {
+    closest8_loop(accel, rays, hits, mode)
+}
+
+/// The body of [`trace_closest8`] and [`trace_primary8`].
+#[inline(always)]
+fn closest8_loop(accel: &Accel, rays: &[Ray], hits: &mut [(u32, f32)], mode: PacketMode) {
+    for (r, h) in rays.chunks_exact(8).zip(hits.chunks_exact_mut(8)) {
+        let found = accel.intersect8(r.try_into().unwrap(), &[f32::INFINITY; 8], mode, leaf_mask);
+        for (f, h) in found.iter().zip(h) {
+            if let Some(hit) = f {
+                *h = (hit.prim, hit.t);
+            }
+        }
+    }
+}
+
+/// [`trace_any`] eight rays a call, each ray's answer (`traversal::trace_any8`).
+#[inline(never)]
+fn trace_any8(accel: &Accel, rays: &[Ray], t_max: &[f32; 8], mode: PacketMode) -> Vec<bool> {
+    let mut out = Vec::with_capacity(rays.len());
+    for r in rays.chunks_exact(8) {
+        let m = accel.occluded8(r.try_into().unwrap(), t_max, mode, leaf_mask);
+        out.extend((0..8).map(|i| m & (1 << i) != 0));
+    }
+    out
+}
+
+/// Shadow rays one at a time (`traversal::trace_shadow`).
+#[inline(never)]
+fn trace_shadow(accel: &Accel, rays: &[Ray], t_max: &[f32]) -> Vec<bool> {
+    rays.iter()
+        .zip(t_max)
+        .map(|(r, &t)| accel.occluded(r, t, leaf_mask))
+        .collect()
+}
+
+/// Shadow rays eight a call (`traversal::trace_shadow8`).
+#[inline(never)]
+fn trace_shadow8(accel: &Accel, rays: &[Ray], t_max: &[f32], mode: PacketMode) -> Vec<bool> {
+    let mut out = Vec::with_capacity(rays.len());
+    for (r, t) in rays.chunks_exact(8).zip(t_max.chunks_exact(8)) {
+        let m = accel.occluded8(
+            r.try_into().unwrap(),
+            t.try_into().unwrap(),
+            mode,
+            leaf_mask,
+        );
+        out.extend((0..8).map(|i| m & (1 << i) != 0));
+    }
+    out
 }
 
 /// The kernels to trace with: `CANDELA_SIMD=scalar|sse|avx2` to measure a fallback, else

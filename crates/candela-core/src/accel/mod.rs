@@ -25,6 +25,7 @@ mod geometry;
 mod indexed;
 mod lanes;
 mod layout;
+mod packet;
 mod sphere;
 
 use glam::Vec3;
@@ -39,6 +40,7 @@ use indexed::IndexedLeaves;
 pub use crate::bvh::Simd;
 pub use geometry::{Geometry, Located, TriangleMesh};
 pub use layout::{AccelLayout, LeafLayout, NodeLayout, INDEXED_FROM};
+pub use packet::PacketMode;
 
 // Every leaf of the build fits one block.
 const _: () = assert!(SahCost::BLOCKS.max_leaf == LANES);

@@ -17,6 +17,7 @@
 mod binary;
 mod box8;
 mod extents;
+mod packet;
 mod quant8;
 mod wide;
 
@@ -24,5 +25,7 @@ pub use binary::{Bvh, BvhNode, SahCost};
 pub use box8::{hit8_scalar, BoxTest, Planes8, Ray8, ScalarBoxes, Simd, T_MAX_SCALE};
 #[cfg(target_arch = "x86_64")]
 pub use box8::{Avx2Boxes, SseBoxes};
+#[cfg(target_arch = "x86_64")]
+pub use packet::{BoxAgainstRays, Children, PacketTest, RaysAgainstBoxes};
 pub use quant8::QBoxes8;
 pub use wide::{prefetch, Node8, QNode8, WideBvh, WideNode};

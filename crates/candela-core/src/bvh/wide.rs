@@ -314,6 +314,23 @@ impl<N: WideNode> WideBvh<N> {
     pub unsafe fn intersect<K: BoxTest>(
         &self,
         ray: &Ray8,
+        t_max: f32,
+        leaf: impl FnMut(u32, u32, f32) -> f32,
+        prefetch_leaf: impl Fn(u32),
+    ) {
+        self.intersect_from::<K>(0, ray, t_max, leaf, prefetch_leaf)
+    }
+
+    /// [`WideBvh::intersect`] in the subtree under node `start` (the packet traversal's
+    /// single rays finish subtrees with it).
+    ///
+    /// # Safety
+    /// As for [`WideBvh::intersect`]; `start` must be a node of this tree.
+    #[inline(always)]
+    pub unsafe fn intersect_from<K: BoxTest>(
+        &self,
+        start: u32,
+        ray: &Ray8,
         mut t_max: f32,
         mut leaf: impl FnMut(u32, u32, f32) -> f32,
         prefetch_leaf: impl Fn(u32),
@@ -334,7 +351,7 @@ impl<N: WideNode> WideBvh<N> {
         // Left uninitialised: zeroing it would cost as much as a shallow traversal.
         let mut stack = [const { MaybeUninit::<Entry>::uninit() }; STACK];
         let mut sp = 0;
-        let mut current = 0usize;
+        let mut current = start as usize;
         // A subtree put off for later: have its memory on the way meanwhile (measured:
         // about 10 % more closest-hit rays/s on the room).
         let wait = |e: &Entry| {
@@ -442,6 +459,21 @@ impl<N: WideNode> WideBvh<N> {
         &self,
         ray: &Ray8,
         t_max: f32,
+        leaf: impl FnMut(u32, u32, f32) -> bool,
+    ) -> bool {
+        self.occluded_from::<K>(0, ray, t_max, leaf)
+    }
+
+    /// [`WideBvh::occluded`] in the subtree under node `start`.
+    ///
+    /// # Safety
+    /// As for [`WideBvh::occluded`]; `start` must be a node of this tree.
+    #[inline(always)]
+    pub unsafe fn occluded_from<K: BoxTest>(
+        &self,
+        start: u32,
+        ray: &Ray8,
+        t_max: f32,
         mut leaf: impl FnMut(u32, u32, f32) -> bool,
     ) -> bool {
         if self.nodes.is_empty() || !ray.finite {
@@ -452,7 +484,7 @@ impl<N: WideNode> WideBvh<N> {
         let t_box = t_max * T_MAX_SCALE;
         let mut stack = [const { MaybeUninit::<u32>::uninit() }; STACK];
         let mut sp = 0;
-        let mut current = 0usize;
+        let mut current = start as usize;
         loop {
             let node = &self.nodes[current];
             let (mask, _) = node.hit::<K>(&r, t_box);
