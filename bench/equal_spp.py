@@ -73,6 +73,8 @@ def main() -> None:
     ap.add_argument("--threads", type=int, default=2)
     ap.add_argument("--ref-spp", type=int, default=4096)
     ap.add_argument("--ref-variant", default="llvm_ad_rgb")
+    ap.add_argument("--binary", default=CANDELA,
+                    help="the candela binary (default: this checkout's release build)")
     ap.add_argument("--candela", action="append", default=None,
                     help="NAME=ARGS: a Candela configuration (repeatable)")
     a = ap.parse_args()
@@ -97,7 +99,7 @@ def main() -> None:
                 (images.relmse(img, ref), trimmed_relmse(img, ref), ns, wall_ns))
             for cname, args in configs:
                 out = os.path.join(OUT, f"{name}-candela-{cname}-{seed}.pfm")
-                cmd = [CANDELA, "render", scene, "-o", out, "--spp", str(a.spp),
+                cmd = [a.binary, "render", scene, "-o", out, "--spp", str(a.spp),
                        "--seed", str(seed), "--threads", str(a.threads),
                        "-D", f"res={a.res}"] + args.split()
                 c0 = children_cpu_s()
