@@ -77,45 +77,19 @@ pub(super) fn validate_mesh(m: &MeshDesc, span: &Span) -> Result<(), BuildError>
     if m.indices.is_empty() || m.positions.is_empty() {
         return err(span, "mesh has no triangles");
     }
-    if !m.normals.is_empty() && m.normals.len() != m.positions.len() {
-        return err(
-            span,
-            format!(
-                "mesh has {} normals for {} positions",
-                m.normals.len(),
-                m.positions.len()
-            ),
-        );
-    }
-    if !m.uvs.is_empty() && m.uvs.len() != m.positions.len() {
-        return err(
-            span,
-            format!(
-                "mesh has {} uvs for {} positions",
-                m.uvs.len(),
-                m.positions.len()
-            ),
-        );
-    }
-    if !m.colors.is_empty() && m.colors.len() != m.positions.len() {
-        return err(
-            span,
-            format!(
-                "mesh has {} colours for {} positions",
-                m.colors.len(),
-                m.positions.len()
-            ),
-        );
-    }
-    if !m.tangents.is_empty() && m.tangents.len() != m.positions.len() {
-        return err(
-            span,
-            format!(
-                "mesh has {} tangents for {} positions",
-                m.tangents.len(),
-                m.positions.len()
-            ),
-        );
+    // Each per-vertex attribute is absent or one a position, checked in this order.
+    for (what, len) in [
+        ("normals", m.normals.len()),
+        ("uvs", m.uvs.len()),
+        ("colours", m.colors.len()),
+        ("tangents", m.tangents.len()),
+    ] {
+        if len != 0 && len != m.positions.len() {
+            return err(
+                span,
+                format!("mesh has {len} {what} for {} positions", m.positions.len()),
+            );
+        }
     }
     if let Some(i) = m
         .indices
