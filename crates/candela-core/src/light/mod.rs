@@ -269,7 +269,7 @@ impl Light {
                 irradiance: luminance(l.irradiance),
                 wi: -l.direction,
             }),
-            Light::Environment(l) => Some(InfiniteImportance::Sky(*l.importance)),
+            Light::Environment(l) => Some(InfiniteImportance::sky(&l.importance)),
             _ => None,
         }
     }
