@@ -22,7 +22,7 @@ STAGES = [
                    "candela_core::accel", "candela_core::bvh", "candela_core::scene::Scene::"]),
     ("hit record", ["scene/interaction.rs", "scene/mesh.rs", "alpha.rs",
                     "candela_core::scene::interaction"]),
-    ("film/splat", ["splat.rs", "film.rs", "exact_sum.rs", "filter.rs", "limb_sums.rs", "candela_core::splat",
+    ("film/splat", ["splat.rs", "film.rs", "exact_sum.rs", "filter.rs", "limb_sums.rs", "lane_expf.rs", "candela_core::splat",
                     "candela_core::film"]),
     ("sampler", ["/sampler/", "candela_core::sampler"]),
     ("camera", ["/camera/", "candela_core::camera"]),
