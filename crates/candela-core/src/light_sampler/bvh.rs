@@ -16,7 +16,8 @@
 use rayon::join;
 
 use crate::light::{
-    cone_measure, ImportanceBounds, InfiniteImportance, Light, LightBounds, ShadingCtx,
+    cone_measure, ImportanceBounds, ImportanceLanes, InfiniteImportance, Light, LightBounds,
+    ShadingCtx,
 };
 use crate::sampling::ONE_MINUS_EPSILON;
 
@@ -69,6 +70,8 @@ pub struct LightBvh {
     /// Where the tree has at most [`FLAT_MAX`] lights: its leaves' node indices, which
     /// sampling weighs directly; empty otherwise.
     flat: Vec<u32>,
+    /// The bounds of `flat`'s leaves in lanes, weighed at once where the CPU has AVX2.
+    flat_lanes: Option<Box<ImportanceLanes>>,
 }
 
 struct Item {
@@ -114,6 +117,7 @@ impl LightBvh {
             infinite_importance,
             trails: vec![0; lights.len()],
             flat: Vec::new(),
+            flat_lanes: None,
         };
         if !items.is_empty() {
             // A subtree over n lights has exactly 2n − 1 nodes, so every subtree's place in
@@ -141,6 +145,12 @@ impl LightBvh {
                 bvh.flat = (0..bvh.nodes.len() as u32)
                     .filter(|&i| bvh.nodes[i as usize].is_leaf)
                     .collect();
+                let bounds: Vec<ImportanceBounds> = bvh
+                    .flat
+                    .iter()
+                    .map(|&i| bvh.nodes[i as usize].bounds)
+                    .collect();
+                bvh.flat_lanes = ImportanceLanes::new(&bounds).map(Box::new);
             }
         }
         Some(bvh)
@@ -255,10 +265,18 @@ impl LightBvh {
     #[inline]
     fn flat_weights(&self, ctx: &ShadingCtx) -> ([f32; FLAT_MAX], f32) {
         let mut w = [0.0f32; FLAT_MAX];
+        match &self.flat_lanes {
+            // The same bits as the loop below, eight lights in one evaluation.
+            Some(lanes) => w = lanes.importance(ctx),
+            None => {
+                for (w, &leaf) in w.iter_mut().zip(&self.flat) {
+                    *w = self.nodes[leaf as usize].bounds.importance(ctx);
+                }
+            }
+        }
         let mut total = 0.0;
-        for (w, &leaf) in w.iter_mut().zip(&self.flat) {
-            *w = self.nodes[leaf as usize].bounds.importance(ctx);
-            total += *w;
+        for &w in &w[..self.flat.len()] {
+            total += w;
         }
         (w, total)
     }
