@@ -4,9 +4,14 @@
 //! samples. The expected image is the filtered one that splatting renderers such as
 //! Mitsuba produce, without samples crossing pixel (and thread) boundaries.
 
+#[cfg(target_arch = "x86_64")]
+use std::arch::x86_64::*;
+
 use glam::Vec2;
 
 use crate::desc::PixelFilterDesc;
+#[cfg(target_arch = "x86_64")]
+use crate::lane_expf;
 use crate::sampling::Distribution1D;
 
 /// Cells of the tabulated Gaussian: its piecewise-constant stand-in differs from the
@@ -113,6 +118,41 @@ impl PixelFilter {
             PixelFilter::Tent { radius } => (1.0 - x.abs() / radius).max(0.0),
             PixelFilter::Gaussian { stddev, tail, .. } => gaussian(x, *stddev, *tail),
         }
+    }
+
+    /// [`Self::eval_axis`] at eight offsets at once, with the same bits, for the v3 render
+    /// loop: the Gaussian's exponentials in [`lane_expf`] lanes. `None` where the filter
+    /// is not a Gaussian or an exponential's argument is beyond [`lane_expf::in_range`]
+    /// (a σ far below the radius): the caller then evaluates the offsets one by one.
+    ///
+    /// # Safety
+    /// The CPU must have AVX2 and FMA.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx,avx2,fma")]
+    #[inline]
+    pub fn eval_axis8(&self, x: __m256) -> Option<__m256> {
+        let PixelFilter::Gaussian { stddev, tail, .. } = self else {
+            return None;
+        };
+        // −x²/(2σ²) rounded as `gaussian_curve` rounds it: (−x·x) / ((2σ)·σ).
+        let minus_zero = _mm256_set1_ps(-0.0);
+        let arg = _mm256_div_ps(
+            _mm256_xor_ps(_mm256_mul_ps(x, x), minus_zero),
+            _mm256_set1_ps(2.0 * stddev * stddev),
+        );
+        // |arg| < 88, `in_range` for every lane (NaN fails the ordered comparison).
+        let inside =
+            _mm256_cmp_ps::<_CMP_LT_OQ>(_mm256_andnot_ps(minus_zero, arg), _mm256_set1_ps(88.0));
+        if _mm256_movemask_ps(inside) != 0xff {
+            return None;
+        }
+        let curve = lane_expf::expf8(arg);
+        // `gaussian`: less the tail, clamped at 0 (`maxps` returns its 0 for a NaN, as
+        // `f32::max` does).
+        Some(_mm256_max_ps(
+            _mm256_sub_ps(curve, _mm256_set1_ps(*tail)),
+            _mm256_setzero_ps(),
+        ))
     }
 }
 

@@ -34,6 +34,7 @@ pub mod geometry;
 pub mod instance;
 pub mod integrator;
 pub mod isa;
+pub mod lane_expf;
 pub mod light;
 pub mod light_sampler;
 pub mod limb_sums;

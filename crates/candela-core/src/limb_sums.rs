@@ -64,50 +64,42 @@ impl LimbSums {
 }
 
 /// [`LimbSums::add_weighted`] in AVX2, four channels at once, for `rgb1` = (r, g, b, 1)
-/// of the sample in `f64` (see [`rgb1`]). The limbs differ from the scalar path's
-/// (sign and magnitude instead of floor and remainder), their value `hi·2⁴⁸ + lo` does
-/// not.
+/// of the sample in `f64` scaled by 2⁵⁶ (see [`rgb1`]) and the weight in every lane of
+/// `weight`. The limbs are the scalar path's (floor and remainder), some 15 instructions.
 ///
 /// # Safety
-/// The CPU must have AVX2.
+/// The CPU must have AVX2 and FMA.
 #[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx,avx2")]
+#[target_feature(enable = "avx,avx2,fma")]
 #[inline]
-pub fn add_weighted_avx2(sums: &mut LimbSums, rgb1: std::arch::x86_64::__m256d, weight: f32) {
+pub fn add_weighted_avx2(
+    sums: &mut LimbSums,
+    rgb1: std::arch::x86_64::__m256d,
+    weight: std::arch::x86_64::__m256d,
+) {
     use std::arch::x86_64::*;
-    // The terms, exact in f64 (products of two f32), scaled exactly by 2⁵⁶.
-    let t = _mm256_mul_pd(rgb1, _mm256_set1_pd(weight as f64 * (1u64 << 56) as f64));
-    let t_bits = _mm256_castpd_si256(t);
-    let negative = _mm256_cmpgt_epi64(_mm256_setzero_si256(), t_bits);
-    let a = _mm256_castpd_si256(_mm256_andnot_pd(_mm256_set1_pd(-0.0), t));
-    let two_52 = _mm256_set1_pd((1u64 << 52) as f64);
-    let small = _mm256_castpd_si256(_mm256_cmp_pd::<_CMP_LT_OQ>(_mm256_castsi256_pd(a), two_52));
-    // Below 2⁵²: rounded to an integer, ties to even, by adding 2⁵² (see
-    // `exact_sum::to_fixed`), with no shift. Above: the significand, shifted by the
-    // exponent less 52.
-    let rounded = _mm256_sub_epi64(
-        _mm256_castpd_si256(_mm256_add_pd(_mm256_castsi256_pd(a), two_52)),
-        _mm256_castpd_si256(two_52),
-    );
-    let significand = _mm256_or_si256(
-        _mm256_and_si256(a, _mm256_set1_epi64x((1 << 52) - 1)),
-        _mm256_set1_epi64x(1 << 52),
-    );
-    let exponent = _mm256_sub_epi64(_mm256_srli_epi64::<52>(a), _mm256_set1_epi64x(1075));
-    let m = _mm256_blendv_epi8(significand, rounded, small);
-    let shift = _mm256_andnot_si256(small, exponent);
-    // The magnitude m·2^shift (< 2⁹⁶) as lo + hi·2⁴⁸.
-    let lo = _mm256_and_si256(
-        _mm256_sllv_epi64(m, shift),
-        _mm256_set1_epi64x((1 << LO_BITS) - 1),
-    );
-    let hi = _mm256_srlv_epi64(
-        m,
-        _mm256_sub_epi64(_mm256_set1_epi64x(LO_BITS as i64), shift),
-    );
-    // Negated where the term is negative: (x ^ −1) − (−1) = −x.
-    let lo = _mm256_sub_epi64(_mm256_xor_si256(lo, negative), negative);
-    let hi = _mm256_sub_epi64(_mm256_xor_si256(hi, negative), negative);
+    // The terms in units of 2⁻⁵⁶, exact (a product of two f32 scaled by a power of two).
+    let t = _mm256_mul_pd(rgb1, weight);
+    // Rounded to integers, ties to even, as `ExactSum::of` rounds; |v| < 2⁹⁶ (an integer
+    // valued f64: exact).
+    let v = _mm256_round_pd::<{ _MM_FROUND_TO_NEAREST_INT | _MM_FROUND_NO_EXC }>(t);
+    // v = hi·2⁴⁸ + lo with hi = ⌊v/2⁴⁸⌋ (|hi| ≤ 2⁴⁸) and lo ∈ [0, 2⁴⁸): a power-of-two
+    // scaling, a floor, and a difference that is representable, so all exact.
+    let hi = _mm256_round_pd::<{ _MM_FROUND_TO_NEG_INF | _MM_FROUND_NO_EXC }>(_mm256_mul_pd(
+        v,
+        _mm256_set1_pd(1.0 / (1u64 << LO_BITS) as f64),
+    ));
+    let lo = _mm256_fnmadd_pd(hi, _mm256_set1_pd((1u64 << LO_BITS) as f64), v);
+    // Integers below 2⁵¹ in magnitude to i64: 1.5·2⁵² + x lies in [2⁵², 2⁵³), where
+    // the float's bits grow by one per unit, so its bits less those of 1.5·2⁵² are x.
+    let magic = _mm256_set1_pd(1.5 * (1u64 << 52) as f64);
+    let to_i64 = |x: __m256d| {
+        _mm256_sub_epi64(
+            _mm256_castpd_si256(_mm256_add_pd(x, magic)),
+            _mm256_castpd_si256(magic),
+        )
+    };
+    let (lo, hi) = (to_i64(lo), to_i64(hi));
     // SAFETY: `LimbSums` is 32-byte aligned, `lo` and `hi` its two 32-byte halves.
     unsafe {
         let p_lo = sums.lo.as_mut_ptr() as *mut __m256i;
@@ -117,7 +109,8 @@ pub fn add_weighted_avx2(sums: &mut LimbSums, rgb1: std::arch::x86_64::__m256d, 
     }
 }
 
-/// A sample's (r, g, b, 1) in `f64`, for [`add_weighted_avx2`].
+/// A sample's (r, g, b, 1)·2⁵⁶ in `f64` (exact: a power-of-two scaling of `f32`s below
+/// 2⁴⁰), for [`add_weighted_avx2`].
 ///
 /// # Safety
 /// The CPU must have AVX2.
@@ -126,7 +119,10 @@ pub fn add_weighted_avx2(sums: &mut LimbSums, rgb1: std::arch::x86_64::__m256d, 
 #[inline]
 pub fn rgb1(radiance: Vec3) -> std::arch::x86_64::__m256d {
     use std::arch::x86_64::*;
-    _mm256_cvtps_pd(_mm_set_ps(1.0, radiance.z, radiance.y, radiance.x))
+    _mm256_mul_pd(
+        _mm256_cvtps_pd(_mm_set_ps(1.0, radiance.z, radiance.y, radiance.x)),
+        _mm256_set1_pd((1u64 << 56) as f64),
+    )
 }
 
 #[cfg(test)]
@@ -135,7 +131,7 @@ mod tests {
 
     /// Random radiances (every magnitude up to the film's limit, both signs, zeros) and
     /// weights: the folded limbs give the bits of `Pixel::add_weighted`, by the scalar
-    /// path and by the AVX2 one where the CPU has it.
+    /// path and by the AVX2 one where the CPU has it (limbs equal too).
     #[test]
     fn folded_limbs_equal_the_exact_sums() {
         let mut state = 0x9e37_79b9_7f4a_7c15u64;
@@ -151,7 +147,9 @@ mod tests {
             }
             f32::from_bits(((bits as u32) & 0x807f_ffff) | ((exp as u32) << 23))
         };
-        let avx2 = cfg!(target_arch = "x86_64") && std::arch::is_x86_feature_detected!("avx2");
+        let avx2 = cfg!(target_arch = "x86_64")
+            && std::arch::is_x86_feature_detected!("avx2")
+            && std::arch::is_x86_feature_detected!("fma");
         for _ in 0..200 {
             let mut exact = Pixel::default();
             let mut scalar = LimbSums::default();
@@ -165,9 +163,15 @@ mod tests {
                 scalar.add_weighted(l, w);
                 #[cfg(target_arch = "x86_64")]
                 if avx2 {
-                    // SAFETY: the CPU has AVX2 (checked above).
-                    unsafe { add_weighted_avx2(&mut lanes, rgb1(l), w) };
+                    // SAFETY: the CPU has AVX2 and FMA (checked above).
+                    unsafe {
+                        let w = std::arch::x86_64::_mm256_set1_pd(w as f64);
+                        add_weighted_avx2(&mut lanes, rgb1(l), w)
+                    };
                 }
+            }
+            if avx2 {
+                assert_eq!((lanes.lo, lanes.hi), (scalar.lo, scalar.hi));
             }
             let mut a = Pixel::default();
             scalar.fold_into(&mut a);

@@ -212,6 +212,19 @@ impl SkyImportance {
     pub fn at(&self, ctx: &ShadingCtx) -> f32 {
         self.excess.brighter_side(ctx) + SKY_FLOOR * self.all.brighter_side(ctx)
     }
+
+    /// Where the sky's irradiance is the same on every side (a constant sky: no linear
+    /// or quadratic term), its importance on a surface and where there is no surface,
+    /// which [`Self::at`] then returns at every point: the quadratic forms' terms in n
+    /// are zero, so n·(A n) + c + |b·n| is c exactly.
+    pub fn even(&self) -> Option<(f32, f32)> {
+        let even = |s: &SkyIrradiance| s.a == Mat3::ZERO && s.b == Vec3::ZERO;
+        (even(&self.all) && even(&self.excess)).then(|| {
+            let surface = self.excess.c.max(0.0) + SKY_FLOOR * self.all.c.max(0.0);
+            let volume = self.excess.fluence + SKY_FLOOR * self.all.fluence;
+            (surface, volume)
+        })
+    }
 }
 
 /// What the light BVH keeps of an infinite light to weigh it at a shading point.
@@ -222,15 +235,35 @@ pub enum InfiniteImportance {
     Direction { irradiance: f32, wi: Vec3 },
     /// An environment.
     Sky(SkyImportance),
+    /// An environment whose importance is the same at every point with a normal
+    /// (`surface`) and at every point without one (`volume`): see
+    /// [`SkyImportance::even`]. Weighing it costs a comparison, not two quadratic forms.
+    EvenSky { surface: f32, volume: f32 },
 }
 
 impl InfiniteImportance {
+    /// An environment's: [`InfiniteImportance::EvenSky`] where [`SkyImportance::even`]
+    /// says so, else [`InfiniteImportance::Sky`].
+    pub fn sky(s: &SkyImportance) -> InfiniteImportance {
+        match s.even() {
+            Some((surface, volume)) => InfiniteImportance::EvenSky { surface, volume },
+            None => InfiniteImportance::Sky(*s),
+        }
+    }
+
     /// The light's importance at `ctx` (what its `LightSource::importance` answers).
     #[inline]
     pub fn at(&self, ctx: &ShadingCtx) -> f32 {
         match self {
             InfiniteImportance::Direction { irradiance, wi } => irradiance * receiver_cos(ctx, *wi),
             InfiniteImportance::Sky(s) => s.at(ctx),
+            InfiniteImportance::EvenSky { surface, volume } => {
+                if ctx.n == Vec3::ZERO {
+                    *volume
+                } else {
+                    *surface
+                }
+            }
         }
     }
 }
@@ -326,6 +359,13 @@ mod tests {
         };
         let even = SkyImportance::constant(1.0);
         assert!((even.at(&ctx) - PI / 16.0).abs() < 1e-6);
+        // Its even form answers the same bits on a surface and off one.
+        let fast = InfiniteImportance::sky(&even);
+        assert!(matches!(fast, InfiniteImportance::EvenSky { .. }));
+        for n in [Vec3::Y, -Vec3::X, Vec3::new(0.48, -0.6, 0.64), Vec3::ZERO] {
+            let ctx = ShadingCtx { p: Vec3::ONE, n };
+            assert_eq!(fast.at(&ctx).to_bits(), even.at(&ctx).to_bits(), "{n}");
+        }
         // 1 % of the sphere 10⁴ times brighter than the rest, straight up: nearly all of
         // the light is above the mean, and the surface facing it sees nearly all of it.
         let patches = (0..10_000).map(|i| {
@@ -341,5 +381,9 @@ mod tests {
         let sun = sky.excess.brighter_side(&ctx);
         assert!(sun > 0.95 * sky.all.brighter_side(&ctx), "{sun}");
         assert!((sky.at(&ctx) - sun - sky.all.brighter_side(&ctx) / 16.0).abs() < 1e-3 * sun);
+        assert!(matches!(
+            InfiniteImportance::sky(&sky),
+            InfiniteImportance::Sky(_)
+        ));
     }
 }

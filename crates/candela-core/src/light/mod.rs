@@ -21,6 +21,7 @@ mod emission_texture;
 mod environment;
 pub mod envmap;
 mod goniometric;
+mod importance_lanes;
 mod infinite_importance;
 mod parallelogram;
 mod point;
@@ -38,6 +39,7 @@ pub use directional::DirectionalLight;
 pub use emission_texture::EmissionTexture;
 pub use environment::{EnvironmentLight, EnvironmentMap, EnvironmentSampling};
 pub use goniometric::GoniometricLight;
+pub use importance_lanes::ImportanceLanes;
 pub use infinite_importance::{InfiniteImportance, SkyImportance, SkyIrradiance};
 pub use parallelogram::ParallelogramLight;
 pub use point::PointLight;
@@ -269,7 +271,7 @@ impl Light {
                 irradiance: luminance(l.irradiance),
                 wi: -l.direction,
             }),
-            Light::Environment(l) => Some(InfiniteImportance::Sky(*l.importance)),
+            Light::Environment(l) => Some(InfiniteImportance::sky(&l.importance)),
             _ => None,
         }
     }

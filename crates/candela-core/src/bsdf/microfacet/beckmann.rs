@@ -34,11 +34,24 @@ impl Beckmann {
 /// Smith's Λ of the isotropic α = 1 distribution seen at a = cot θ (Walter et al. 2007,
 /// eq. 25): (erf(a) − 1)/2 + e^(−a²)/(2a√π), written with erfc, whose two terms cancel
 /// less at large a.
+///
+/// From a = [`NEGLIGIBLE_FROM`] on it answers 0: there Λ < 2⁻²⁴, half an ulp of 1, so
+/// 1 + Λ (and 1 + Λ + Λ′), the only way G₁ and G use Λ, rounds to the same `f32` as with
+/// 0; that skips erfc and exp for most directions of a smooth-ish surface (a = cot θ/α).
 fn lambda_unit(a: f32) -> f32 {
-    if a >= 9.0 {
-        // e^(−81) is below f32's smallest normal: nothing is masked.
+    if a >= NEGLIGIBLE_FROM {
         return 0.0;
     }
+    lambda_unit_formula(a)
+}
+
+/// Where [`lambda_unit`]'s formula gives less than 2⁻²⁴ (the exact Λ is 2⁻²⁴ at
+/// a ≈ 3.31; `tests` checks every `f32` from here to 9, where the code skipped it
+/// before, e^(−81) being below f32's smallest normal).
+const NEGLIGIBLE_FROM: f32 = 3.4;
+
+/// Λ by its closed form (see [`lambda_unit`]).
+fn lambda_unit_formula(a: f32) -> f32 {
     (0.5 * ((-a * a).exp() * FRAC_1_SQRT_PI / a - libm::erfcf(a))).max(0.0)
 }
 
@@ -228,6 +241,21 @@ mod tests {
                 "erfinv(erf({x})) = {back}, tolerance {tol:e}"
             );
         }
+    }
+
+    /// [`lambda_unit`]'s shortcut keeps G's bits: at every `f32` a from
+    /// [`NEGLIGIBLE_FROM`] up to 9 (12·10⁶ values) the formula gives less than 2⁻²⁴, so
+    /// adding it to any sum ≥ 1 changes nothing (beyond 9 Λ was skipped before).
+    #[test]
+    fn lambda_is_negligible_where_it_is_skipped() {
+        for bits in NEGLIGIBLE_FROM.to_bits()..9.0f32.to_bits() {
+            let a = f32::from_bits(bits);
+            let l = lambda_unit_formula(a);
+            assert!(l < 2f32.powi(-24), "Λ({a}) = {l:e}");
+            assert_eq!(1.0 + l, 1.0);
+        }
+        // Below the cut the formula still counts: the shortcut is not premature there.
+        assert!(lambda_unit_formula(3.2) > 2f32.powi(-24));
     }
 
     /// Λ against Smith's definition (Smith 1967; Heitz 2014, eq. 70): with μ = cot θ,
