@@ -114,6 +114,17 @@ pub struct Accel {
     /// Whether every primitive is an unfiltered triangle: the AVX2 traversal then runs
     /// a copy whose block tests skip the check for spheres and filters.
     plain: bool,
+    /// The one leaf of a tree that is one node over one leaf ([`WideBvh::sole_leaf`]):
+    /// every primitive fits one block, which queries test straight away.
+    sole_leaf: Option<SoleLeaf>,
+}
+
+/// A leaf as a wide node's lane names it (its block, or its first record), and its
+/// primitive count.
+#[derive(Clone, Copy, Debug)]
+struct SoleLeaf {
+    leaf: u32,
+    count: u32,
 }
 
 impl Accel {
@@ -202,6 +213,9 @@ impl Accel {
             Leaves::Inline(blocks) => blocks.iter().all(Block::is_plain),
             Leaves::Indexed(x) => x.is_plain(),
         };
+        let sole_leaf = bvh
+            .sole_leaf()
+            .map(|(leaf, count)| SoleLeaf { leaf, count });
         let tree = match layout.nodes {
             NodeLayout::Full => Tree::Full(bvh),
             NodeLayout::Quantized => Tree::Quantized(bvh.quantize()),
@@ -211,6 +225,7 @@ impl Accel {
             leaves,
             simd,
             plain,
+            sole_leaf,
         }
     }
 
@@ -262,6 +277,16 @@ impl Accel {
         t_max: f32,
         filter: impl Fn(u32, &TriangleHit) -> bool,
     ) -> Option<Hit> {
+        if let Some(sole) = &self.sole_leaf {
+            return self
+                .sole_hit::<false, _>(sole, ray, t_max, &filter)
+                .map(|h| Hit {
+                    prim: h.id,
+                    t: h.hit.t,
+                    b1: h.hit.b1,
+                    b2: h.hit.b2,
+                });
+        }
         // The leaf layout first, so that each kernel's traversal is compiled once per
         // layout, and the indexed one out of line, so that what callers inline is the
         // inline layout's traversal alone (callgrind, instructions a path against main
@@ -293,6 +318,11 @@ impl Accel {
         t_max: f32,
         filter: impl Fn(u32, &TriangleHit) -> bool,
     ) -> bool {
+        if let Some(sole) = &self.sole_leaf {
+            return self
+                .sole_hit::<true, _>(sole, ray, t_max, &filter)
+                .is_some();
+        }
         match &self.leaves {
             Leaves::Inline(blocks) => self.occluded_in(&blocks[..], ray, t_max, &filter),
             Leaves::Indexed(x) => self.occluded_indexed(x, ray, t_max, &filter),
@@ -423,6 +453,57 @@ impl Accel {
             self.occluded_with::<ScalarBoxes, { block::SCALAR }, false, _>(
                 leaves, ray, t_max, filter,
             )
+        }
+    }
+
+    /// The query of a tree that is one node over one leaf: the block test of that leaf
+    /// alone, without the root's box test, which only culls (the block test is exact, so
+    /// the hits are the traversal's). Out of line and apart from the traversal, so that
+    /// the traversal's code is as it was for other trees (a check inside it cost the spot
+    /// room 1–5 instructions a query, and an arm beside it changed its register use:
+    /// +8 %). With `ANY`, any hit (see [`Block::intersect`]).
+    #[inline(never)]
+    fn sole_hit<const ANY: bool, F: Fn(u32, &TriangleHit) -> bool>(
+        &self,
+        sole: &SoleLeaf,
+        ray: &Ray,
+        t_max: f32,
+        filter: &F,
+    ) -> Option<block::LaneHit> {
+        match &self.leaves {
+            Leaves::Inline(blocks) => {
+                self.sole_hit_in::<ANY, _, _>(&blocks[..], sole, ray, t_max, filter)
+            }
+            Leaves::Indexed(x) => self.sole_hit_in::<ANY, _, _>(x, sole, ray, t_max, filter),
+        }
+    }
+
+    #[inline(always)]
+    fn sole_hit_in<const ANY: bool, L: LeafBlocks + ?Sized, F: Fn(u32, &TriangleHit) -> bool>(
+        &self,
+        leaves: &L,
+        sole: &SoleLeaf,
+        ray: &Ray,
+        t_max: f32,
+        filter: &F,
+    ) -> Option<block::LaneHit> {
+        // SAFETY: `finish` checked that the CPU supports `self.simd`.
+        unsafe {
+            match self.simd {
+                #[cfg(target_arch = "x86_64")]
+                Simd::Avx2 if self.plain => {
+                    sole_avx2::<ANY, true, _, _>(leaves, sole, ray, t_max, filter)
+                }
+                #[cfg(target_arch = "x86_64")]
+                Simd::Avx2 => sole_avx2::<ANY, false, _, _>(leaves, sole, ray, t_max, filter),
+                #[cfg(target_arch = "x86_64")]
+                Simd::Sse => sole_block_hit::<{ block::SSE }, ANY, false, _>(
+                    leaves, sole, ray, t_max, filter,
+                ),
+                _ => sole_block_hit::<{ block::SCALAR }, ANY, false, _>(
+                    leaves, sole, ray, t_max, filter,
+                ),
+            }
         }
     }
 
@@ -600,6 +681,56 @@ unsafe fn occluded_tree<
                 },
             )
         },
+    )
+}
+
+/// [`sole_block_hit`] compiled with AVX2 enabled, so that the block test inlines.
+///
+/// # Safety
+/// The CPU must support AVX2.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2,bmi1,bmi2,lzcnt")]
+unsafe fn sole_avx2<const ANY: bool, const PLAIN: bool, L, F>(
+    leaves: &L,
+    sole: &SoleLeaf,
+    ray: &Ray,
+    t_max: f32,
+    filter: &F,
+) -> Option<block::LaneHit>
+where
+    L: LeafBlocks + ?Sized,
+    F: Fn(u32, &TriangleHit) -> bool,
+{
+    sole_block_hit::<{ block::AVX2 }, ANY, PLAIN, _>(leaves, sole, ray, t_max, filter)
+}
+
+/// The block test of a tree's one leaf (see [`Accel::sole_hit`]). Rays that are not
+/// finite find nothing, as in the traversal.
+///
+/// # Safety
+/// The CPU must support `LEAF`.
+#[inline(always)]
+unsafe fn sole_block_hit<const LEAF: u8, const ANY: bool, const PLAIN: bool, L>(
+    leaves: &L,
+    sole: &SoleLeaf,
+    ray: &Ray,
+    t_max: f32,
+    filter: &impl Fn(u32, &TriangleHit) -> bool,
+) -> Option<block::LaneHit>
+where
+    L: LeafBlocks + ?Sized,
+{
+    if !crate::bvh::finite(ray) {
+        return None;
+    }
+    // The same bits as the traversal's `from_recip` (the same division).
+    let wray = WatertightRay::new(ray);
+    let count = sole.count;
+    leaves.with_block(
+        sole.leaf,
+        count,
+        #[inline(always)]
+        |block| block.intersect::<LEAF, ANY, PLAIN>(ray, &wray, count, t_max, filter),
     )
 }
 
