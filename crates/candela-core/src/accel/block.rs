@@ -359,8 +359,13 @@ impl Block {
         let sph = if MIXED { (spheres >> first) & used } else { 0 };
         let (sphere_hit, sphere_t) = if sph != 0 {
             let at = |vertex: usize, axis: usize| self.v[vertex][axis].as_ptr().add(first);
-            let (hit, t) =
-                sphere::intersect_spheres::<V>(ray, [0, 1, 2].map(|k| at(0, k)), at(1, 0), t_max);
+            let (hit, t) = sphere::intersect_spheres::<V>(
+                ray,
+                [0, 1, 2].map(|k| at(0, k)),
+                at(1, 0),
+                t_max,
+                sph,
+            );
             (hit.and(V::from_bits(sph)), t)
         } else {
             (zero, zero)
