@@ -458,11 +458,13 @@ impl Accel {
 
     /// The query of a tree that is one node over one leaf: the block test of that leaf
     /// alone, without the root's box test, which only culls (the block test is exact, so
-    /// the hits are the traversal's). Out of line and apart from the traversal, so that
-    /// the traversal's code is as it was for other trees (a check inside it cost the spot
-    /// room 1–5 instructions a query, and an arm beside it changed its register use:
-    /// +8 %). With `ANY`, any hit (see [`Block::intersect`]).
-    #[inline(never)]
+    /// the hits are the traversal's). Apart from the traversal, so that the traversal's
+    /// code is as it was for other trees (a check inside it cost the spot room 1–5
+    /// instructions a query, and an arm beside it changed its register use: +8 %). As
+    /// for the traversal, a dispatch inlined into the caller and one call: the AVX2 test
+    /// compiled for AVX2, the others out of line (an out-of-line dispatch cost 42
+    /// instructions a query). With `ANY`, any hit (see [`Block::intersect`]).
+    #[inline(always)]
     fn sole_hit<const ANY: bool, F: Fn(u32, &TriangleHit) -> bool>(
         &self,
         sole: &SoleLeaf,
@@ -471,15 +473,26 @@ impl Accel {
         filter: &F,
     ) -> Option<block::LaneHit> {
         match &self.leaves {
+            // SAFETY: `finish` checked that the CPU supports `self.simd`.
+            #[cfg(target_arch = "x86_64")]
+            Leaves::Inline(blocks) if self.simd == Simd::Avx2 => unsafe {
+                if self.plain {
+                    sole_avx2::<ANY, true, _, _>(&blocks[..], sole, ray, t_max, filter)
+                } else {
+                    sole_avx2::<ANY, false, _, _>(&blocks[..], sole, ray, t_max, filter)
+                }
+            },
             Leaves::Inline(blocks) => {
-                self.sole_hit_in::<ANY, _, _>(&blocks[..], sole, ray, t_max, filter)
+                self.sole_hit_other::<ANY, _, _>(&blocks[..], sole, ray, t_max, filter)
             }
-            Leaves::Indexed(x) => self.sole_hit_in::<ANY, _, _>(x, sole, ray, t_max, filter),
+            Leaves::Indexed(x) => self.sole_hit_other::<ANY, _, _>(x, sole, ray, t_max, filter),
         }
     }
 
-    #[inline(always)]
-    fn sole_hit_in<const ANY: bool, L: LeafBlocks + ?Sized, F: Fn(u32, &TriangleHit) -> bool>(
+    /// [`Accel::sole_hit`] with every kernel on indexed leaves, and with the SSE and
+    /// scalar kernels on inline blocks.
+    #[inline(never)]
+    fn sole_hit_other<const ANY: bool, L: LeafBlocks + ?Sized, F: Fn(u32, &TriangleHit) -> bool>(
         &self,
         leaves: &L,
         sole: &SoleLeaf,
