@@ -358,8 +358,12 @@ impl Accel {
                 #[cfg(target_arch = "x86_64")]
                 Simd::Avx2 => self.intersect_avx2::<false, _, _>(leaves, ray, t_max, filter),
                 #[cfg(target_arch = "x86_64")]
-                Simd::Sse => self.intersect_sse(leaves, ray, t_max, filter),
-                _ => self.intersect_scalar(leaves, ray, t_max, filter),
+                Simd::Sse => self.intersect_out_of_line::<SseBoxes, { block::SSE }, _, _>(
+                    leaves, ray, t_max, filter,
+                ),
+                _ => self.intersect_out_of_line::<ScalarBoxes, { block::SCALAR }, _, _>(
+                    leaves, ray, t_max, filter,
+                ),
             }
         }
     }
@@ -382,8 +386,12 @@ impl Accel {
                 #[cfg(target_arch = "x86_64")]
                 Simd::Avx2 => self.occluded_avx2::<false, _, _>(leaves, ray, t_max, filter),
                 #[cfg(target_arch = "x86_64")]
-                Simd::Sse => self.occluded_sse(leaves, ray, t_max, filter),
-                _ => self.occluded_scalar(leaves, ray, t_max, filter),
+                Simd::Sse => self.occluded_out_of_line::<SseBoxes, { block::SSE }, _, _>(
+                    leaves, ray, t_max, filter,
+                ),
+                _ => self.occluded_out_of_line::<ScalarBoxes, { block::SCALAR }, _, _>(
+                    leaves, ray, t_max, filter,
+                ),
             }
         }
     }
@@ -394,66 +402,42 @@ impl Accel {
     // traversal, instead of an out-of-line function with an 8 KiB stack frame (two
     // stack probes) around that call (callgrind: about 40 instructions a query).
 
-    #[cfg(target_arch = "x86_64")]
+    /// [`Accel::intersect_with`] out of line.
+    ///
+    /// # Safety
+    /// The CPU must support `K` and `LEAF`.
     #[inline(never)]
-    fn intersect_sse<L: LeafBlocks + ?Sized, F: Fn(u32, &TriangleHit) -> bool>(
+    unsafe fn intersect_out_of_line<K: BoxTest, const LEAF: u8, L, F>(
         &self,
         leaves: &L,
         ray: &Ray,
         t_max: f32,
         filter: &F,
-    ) -> Option<Hit> {
-        // SAFETY: SSE is part of the x86-64 baseline.
-        unsafe {
-            self.intersect_with::<SseBoxes, { block::SSE }, false, _>(leaves, ray, t_max, filter)
-        }
+    ) -> Option<Hit>
+    where
+        L: LeafBlocks + ?Sized,
+        F: Fn(u32, &TriangleHit) -> bool,
+    {
+        self.intersect_with::<K, LEAF, false, _>(leaves, ray, t_max, filter)
     }
 
+    /// [`Accel::occluded_with`] out of line.
+    ///
+    /// # Safety
+    /// The CPU must support `K` and `LEAF`.
     #[inline(never)]
-    fn intersect_scalar<L: LeafBlocks + ?Sized, F: Fn(u32, &TriangleHit) -> bool>(
+    unsafe fn occluded_out_of_line<K: BoxTest, const LEAF: u8, L, F>(
         &self,
         leaves: &L,
         ray: &Ray,
         t_max: f32,
         filter: &F,
-    ) -> Option<Hit> {
-        // SAFETY: the scalar kernels run everywhere.
-        unsafe {
-            self.intersect_with::<ScalarBoxes, { block::SCALAR }, false, _>(
-                leaves, ray, t_max, filter,
-            )
-        }
-    }
-
-    #[cfg(target_arch = "x86_64")]
-    #[inline(never)]
-    fn occluded_sse<L: LeafBlocks + ?Sized, F: Fn(u32, &TriangleHit) -> bool>(
-        &self,
-        leaves: &L,
-        ray: &Ray,
-        t_max: f32,
-        filter: &F,
-    ) -> bool {
-        // SAFETY: SSE is part of the x86-64 baseline.
-        unsafe {
-            self.occluded_with::<SseBoxes, { block::SSE }, false, _>(leaves, ray, t_max, filter)
-        }
-    }
-
-    #[inline(never)]
-    fn occluded_scalar<L: LeafBlocks + ?Sized, F: Fn(u32, &TriangleHit) -> bool>(
-        &self,
-        leaves: &L,
-        ray: &Ray,
-        t_max: f32,
-        filter: &F,
-    ) -> bool {
-        // SAFETY: the scalar kernels run everywhere.
-        unsafe {
-            self.occluded_with::<ScalarBoxes, { block::SCALAR }, false, _>(
-                leaves, ray, t_max, filter,
-            )
-        }
+    ) -> bool
+    where
+        L: LeafBlocks + ?Sized,
+        F: Fn(u32, &TriangleHit) -> bool,
+    {
+        self.occluded_with::<K, LEAF, false, _>(leaves, ray, t_max, filter)
     }
 
     /// The query of a tree that is one node over one leaf: the block test of that leaf
