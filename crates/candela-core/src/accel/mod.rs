@@ -2,7 +2,9 @@
 //! scene's primitives, each leaf's primitives copied into one [`block::Block`] of eight
 //! lanes with the vertices inline (no index → mesh → position chase), tested eight at a
 //! time. The build sizes leaves knowing that a leaf of up to eight triangles costs one
-//! block test ([`SahCost::BLOCKS`]).
+//! block test ([`SahCost::BLOCKS`]). A tree of one node over one leaf (a scene whose
+//! primitives fit one block) is queried by that block's test alone, without the root's
+//! box test (which only culls).
 //!
 //! Triangles keep the watertight test (Woop et al. 2013) on the same vertex values as
 //! the meshes, so a hit's distance is the same bits as the mesh's own test gives. Each
