@@ -52,6 +52,7 @@ fn mesh_bytes(m: &Mesh) -> usize {
         + size_of_val(&m.indices[..])
         + size_of_val(&m.lights[..])
         + size_of_val(&m.face_normals[..])
+        + size_of_val(&m.face_dpdu[..])
 }
 
 /// The peak after loading and after building, and the process's peak now: which phase

@@ -11,7 +11,8 @@
 //!
 //! Leaves are blocks of up to eight lanes, so these scenes hold blocks of every fill, and
 //! the soup mixes spheres among its triangles (`accel::block`'s own test checks each
-//! fill and mix lane by lane).
+//! fill and mix lane by lane). Scenes of one leaf (one triangle; a block of triangles and
+//! spheres) take the queries' path without box tests.
 //!
 //! Every SIMD kernel set the CPU has (`Simd::available`, always including the scalar
 //! fallback) is checked the same way, with both node layouts (full planes and quantized
@@ -26,7 +27,7 @@ use candela_core::accel::{
     accept_all, Accel, AccelLayout, Geometry, Hit, LeafLayout, NodeLayout, Shape, Simd,
     TriangleMesh,
 };
-use candela_core::bvh::Bvh;
+use candela_core::bvh::{Bvh, SahCost, WideBvh};
 use candela_core::geometry::{intersect_sphere, Aabb, Ray, WatertightRay};
 use candela_core::sampler::Pcg32;
 use glam::Vec3;
@@ -290,6 +291,7 @@ fn same_hits_as_brute_force_and_the_binary_bvh() {
     });
     scenes.push(("degenerate", degenerate));
     scenes.push(("one triangle", vec![one]));
+    scenes.push(("one block", one_block(&mut rng)));
     scenes.push(("empty", vec![]));
 
     for (name, shapes) in &scenes {
@@ -314,6 +316,51 @@ fn same_hits_as_brute_force_and_the_binary_bvh() {
         .collect();
     let hits = check_scene("soup, rays not unit", soup, &rays, &mut rng);
     assert!(hits > 1000, "rays not unit: only {hits} hits");
+}
+
+/// Five triangles and three spheres whose boxes all nearly fill the unit cube: no split
+/// pays, so the tree is one leaf.
+fn one_block(rng: &mut Pcg32) -> Vec<Shape> {
+    let mut near = |c: Vec3| c + (v3(rng) - 0.5) * 0.2;
+    let mut shapes = Vec::new();
+    for _ in 0..5 {
+        let v = [
+            Vec3::ZERO,
+            Vec3::new(1.0, 1.0, 0.0),
+            Vec3::new(0.0, 1.0, 1.0),
+        ]
+        .map(&mut near);
+        shapes.push(Shape::Triangle(v));
+    }
+    for _ in 0..3 {
+        shapes.push(Shape::Sphere {
+            center: near(Vec3::splat(0.5)),
+            radius: 0.5,
+        });
+    }
+    shapes
+}
+
+/// A tree of one leaf is recognised (its queries skip the box test; the scenes "one
+/// triangle" and "one block" above check their hits), and one that needs two leaves is not.
+#[test]
+fn a_tree_of_one_leaf_is_recognised() {
+    let mut rng = Pcg32::new(35, 2);
+    let sole = |shapes: &[Shape]| {
+        let boxes = boxes(shapes);
+        let bvh = Bvh::build_from(boxes.len(), |i| boxes[i], SahCost::BLOCKS);
+        WideBvh::collapse(&bvh).sole_leaf()
+    };
+    let one = Shape::Triangle([Vec3::ZERO, Vec3::X, Vec3::Y]);
+    assert_eq!(sole(&[one]), Some((0, 1)));
+    assert_eq!(sole(&[one; 8]), Some((0, 8)));
+    for _ in 0..20 {
+        assert_eq!(sole(&one_block(&mut rng)), Some((0, 8)));
+    }
+    // More than a leaf holds.
+    assert_eq!(sole(&[one; 9]), None);
+    assert_eq!(sole(&random_soup(&mut rng, 40, 4)), None);
+    assert_eq!(sole(&[]), None);
 }
 
 #[test]

@@ -2,7 +2,9 @@
 //! scene's primitives, each leaf's primitives copied into one [`block::Block`] of eight
 //! lanes with the vertices inline (no index → mesh → position chase), tested eight at a
 //! time. The build sizes leaves knowing that a leaf of up to eight triangles costs one
-//! block test ([`SahCost::BLOCKS`]).
+//! block test ([`SahCost::BLOCKS`]). A tree of one node over one leaf (a scene whose
+//! primitives fit one block) is queried by that block's test alone, without the root's
+//! box test (which only culls).
 //!
 //! Triangles keep the watertight test (Woop et al. 2013) on the same vertex values as
 //! the meshes, so a hit's distance is the same bits as the mesh's own test gives. Each
@@ -114,6 +116,17 @@ pub struct Accel {
     /// Whether every primitive is an unfiltered triangle: the AVX2 traversal then runs
     /// a copy whose block tests skip the check for spheres and filters.
     plain: bool,
+    /// The one leaf of a tree that is one node over one leaf ([`WideBvh::sole_leaf`]):
+    /// every primitive fits one block, which queries test straight away.
+    sole_leaf: Option<SoleLeaf>,
+}
+
+/// A leaf as a wide node's lane names it (its block, or its first record), and its
+/// primitive count.
+#[derive(Clone, Copy, Debug)]
+struct SoleLeaf {
+    leaf: u32,
+    count: u32,
 }
 
 impl Accel {
@@ -202,6 +215,9 @@ impl Accel {
             Leaves::Inline(blocks) => blocks.iter().all(Block::is_plain),
             Leaves::Indexed(x) => x.is_plain(),
         };
+        let sole_leaf = bvh
+            .sole_leaf()
+            .map(|(leaf, count)| SoleLeaf { leaf, count });
         let tree = match layout.nodes {
             NodeLayout::Full => Tree::Full(bvh),
             NodeLayout::Quantized => Tree::Quantized(bvh.quantize()),
@@ -211,6 +227,7 @@ impl Accel {
             leaves,
             simd,
             plain,
+            sole_leaf,
         }
     }
 
@@ -254,14 +271,24 @@ impl Accel {
     }
 
     /// The nearest hit within (0, t_max); hits on flagged triangles count only where
-    /// `filter` accepts them.
-    #[inline]
+    /// `filter` accepts them. (Always inlined: a dispatch and one call.)
+    #[inline(always)]
     pub fn intersect(
         &self,
         ray: &Ray,
         t_max: f32,
         filter: impl Fn(u32, &TriangleHit) -> bool,
     ) -> Option<Hit> {
+        if let Some(sole) = &self.sole_leaf {
+            return self
+                .sole_hit::<false, _>(sole, ray, t_max, &filter)
+                .map(|h| Hit {
+                    prim: h.id,
+                    t: h.hit.t,
+                    b1: h.hit.b1,
+                    b2: h.hit.b2,
+                });
+        }
         // The leaf layout first, so that each kernel's traversal is compiled once per
         // layout, and the indexed one out of line, so that what callers inline is the
         // inline layout's traversal alone (callgrind, instructions a path against main
@@ -285,14 +312,19 @@ impl Accel {
     }
 
     /// Whether anything accepted by `filter` lies on the ray within (0, t_max); stops
-    /// at the first blocker found.
-    #[inline]
+    /// at the first blocker found. (Always inlined: a dispatch and one call.)
+    #[inline(always)]
     pub fn occluded(
         &self,
         ray: &Ray,
         t_max: f32,
         filter: impl Fn(u32, &TriangleHit) -> bool,
     ) -> bool {
+        if let Some(sole) = &self.sole_leaf {
+            return self
+                .sole_hit::<true, _>(sole, ray, t_max, &filter)
+                .is_some();
+        }
         match &self.leaves {
             Leaves::Inline(blocks) => self.occluded_in(&blocks[..], ray, t_max, &filter),
             Leaves::Indexed(x) => self.occluded_indexed(x, ray, t_max, &filter),
@@ -328,10 +360,10 @@ impl Accel {
                 #[cfg(target_arch = "x86_64")]
                 Simd::Avx2 => self.intersect_avx2::<false, _, _>(leaves, ray, t_max, filter),
                 #[cfg(target_arch = "x86_64")]
-                Simd::Sse => self.intersect_with::<SseBoxes, { block::SSE }, false, _>(
+                Simd::Sse => self.intersect_out_of_line::<SseBoxes, { block::SSE }, _, _>(
                     leaves, ray, t_max, filter,
                 ),
-                _ => self.intersect_with::<ScalarBoxes, { block::SCALAR }, false, _>(
+                _ => self.intersect_out_of_line::<ScalarBoxes, { block::SCALAR }, _, _>(
                     leaves, ray, t_max, filter,
                 ),
             }
@@ -356,11 +388,119 @@ impl Accel {
                 #[cfg(target_arch = "x86_64")]
                 Simd::Avx2 => self.occluded_avx2::<false, _, _>(leaves, ray, t_max, filter),
                 #[cfg(target_arch = "x86_64")]
-                Simd::Sse => self.occluded_with::<SseBoxes, { block::SSE }, false, _>(
+                Simd::Sse => self.occluded_out_of_line::<SseBoxes, { block::SSE }, _, _>(
                     leaves, ray, t_max, filter,
                 ),
-                _ => self.occluded_with::<ScalarBoxes, { block::SCALAR }, false, _>(
+                _ => self.occluded_out_of_line::<ScalarBoxes, { block::SCALAR }, _, _>(
                     leaves, ray, t_max, filter,
+                ),
+            }
+        }
+    }
+
+    // The SSE and scalar traversals out of line, like the AVX2 ones (whose target
+    // features keep them there): the dispatch above is then a few instructions that
+    // inline into `Scene::intersect` and `Scene::occluded`, with one call to the chosen
+    // traversal, instead of an out-of-line function with an 8 KiB stack frame (two
+    // stack probes) around that call (callgrind: about 40 instructions a query).
+
+    /// [`Accel::intersect_with`] out of line.
+    ///
+    /// # Safety
+    /// The CPU must support `K` and `LEAF`.
+    #[inline(never)]
+    unsafe fn intersect_out_of_line<K: BoxTest, const LEAF: u8, L, F>(
+        &self,
+        leaves: &L,
+        ray: &Ray,
+        t_max: f32,
+        filter: &F,
+    ) -> Option<Hit>
+    where
+        L: LeafBlocks + ?Sized,
+        F: Fn(u32, &TriangleHit) -> bool,
+    {
+        self.intersect_with::<K, LEAF, false, _>(leaves, ray, t_max, filter)
+    }
+
+    /// [`Accel::occluded_with`] out of line.
+    ///
+    /// # Safety
+    /// The CPU must support `K` and `LEAF`.
+    #[inline(never)]
+    unsafe fn occluded_out_of_line<K: BoxTest, const LEAF: u8, L, F>(
+        &self,
+        leaves: &L,
+        ray: &Ray,
+        t_max: f32,
+        filter: &F,
+    ) -> bool
+    where
+        L: LeafBlocks + ?Sized,
+        F: Fn(u32, &TriangleHit) -> bool,
+    {
+        self.occluded_with::<K, LEAF, false, _>(leaves, ray, t_max, filter)
+    }
+
+    /// The query of a tree that is one node over one leaf: the block test of that leaf
+    /// alone, without the root's box test, which only culls (the block test is exact, so
+    /// the hits are the traversal's). Apart from the traversal, so that the traversal's
+    /// code is as it was for other trees (a check inside it cost the spot room 1–5
+    /// instructions a query, and an arm beside it changed its register use: +8 %). As
+    /// for the traversal, a dispatch inlined into the caller and one call: the AVX2 test
+    /// compiled for AVX2, the others out of line (an out-of-line dispatch cost 42
+    /// instructions a query). With `ANY`, any hit (see [`Block::intersect`]).
+    #[inline(always)]
+    fn sole_hit<const ANY: bool, F: Fn(u32, &TriangleHit) -> bool>(
+        &self,
+        sole: &SoleLeaf,
+        ray: &Ray,
+        t_max: f32,
+        filter: &F,
+    ) -> Option<block::LaneHit> {
+        match &self.leaves {
+            // SAFETY: `finish` checked that the CPU supports `self.simd`.
+            #[cfg(target_arch = "x86_64")]
+            Leaves::Inline(blocks) if self.simd == Simd::Avx2 => unsafe {
+                if self.plain {
+                    sole_avx2::<ANY, true, _, _>(&blocks[..], sole, ray, t_max, filter)
+                } else {
+                    sole_avx2::<ANY, false, _, _>(&blocks[..], sole, ray, t_max, filter)
+                }
+            },
+            Leaves::Inline(blocks) => {
+                self.sole_hit_other::<ANY, _, _>(&blocks[..], sole, ray, t_max, filter)
+            }
+            Leaves::Indexed(x) => self.sole_hit_other::<ANY, _, _>(x, sole, ray, t_max, filter),
+        }
+    }
+
+    /// [`Accel::sole_hit`] with every kernel on indexed leaves, and with the SSE and
+    /// scalar kernels on inline blocks.
+    #[inline(never)]
+    fn sole_hit_other<const ANY: bool, L: LeafBlocks + ?Sized, F: Fn(u32, &TriangleHit) -> bool>(
+        &self,
+        leaves: &L,
+        sole: &SoleLeaf,
+        ray: &Ray,
+        t_max: f32,
+        filter: &F,
+    ) -> Option<block::LaneHit> {
+        // SAFETY: `finish` checked that the CPU supports `self.simd`.
+        unsafe {
+            match self.simd {
+                #[cfg(target_arch = "x86_64")]
+                Simd::Avx2 if self.plain => {
+                    sole_avx2::<ANY, true, _, _>(leaves, sole, ray, t_max, filter)
+                }
+                #[cfg(target_arch = "x86_64")]
+                Simd::Avx2 => sole_avx2::<ANY, false, _, _>(leaves, sole, ray, t_max, filter),
+                #[cfg(target_arch = "x86_64")]
+                Simd::Sse => sole_block_hit::<{ block::SSE }, ANY, false, _>(
+                    leaves, sole, ray, t_max, filter,
+                ),
+                _ => sole_block_hit::<{ block::SCALAR }, ANY, false, _>(
+                    leaves, sole, ray, t_max, filter,
                 ),
             }
         }
@@ -540,6 +680,56 @@ unsafe fn occluded_tree<
                 },
             )
         },
+    )
+}
+
+/// [`sole_block_hit`] compiled with AVX2 enabled, so that the block test inlines.
+///
+/// # Safety
+/// The CPU must support AVX2.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2,bmi1,bmi2,lzcnt")]
+unsafe fn sole_avx2<const ANY: bool, const PLAIN: bool, L, F>(
+    leaves: &L,
+    sole: &SoleLeaf,
+    ray: &Ray,
+    t_max: f32,
+    filter: &F,
+) -> Option<block::LaneHit>
+where
+    L: LeafBlocks + ?Sized,
+    F: Fn(u32, &TriangleHit) -> bool,
+{
+    sole_block_hit::<{ block::AVX2 }, ANY, PLAIN, _>(leaves, sole, ray, t_max, filter)
+}
+
+/// The block test of a tree's one leaf (see [`Accel::sole_hit`]). Rays that are not
+/// finite find nothing, as in the traversal.
+///
+/// # Safety
+/// The CPU must support `LEAF`.
+#[inline(always)]
+unsafe fn sole_block_hit<const LEAF: u8, const ANY: bool, const PLAIN: bool, L>(
+    leaves: &L,
+    sole: &SoleLeaf,
+    ray: &Ray,
+    t_max: f32,
+    filter: &impl Fn(u32, &TriangleHit) -> bool,
+) -> Option<block::LaneHit>
+where
+    L: LeafBlocks + ?Sized,
+{
+    if !crate::bvh::finite(ray) {
+        return None;
+    }
+    // The same bits as the traversal's `from_recip` (the same division).
+    let wray = WatertightRay::new(ray);
+    let count = sole.count;
+    leaves.with_block(
+        sole.leaf,
+        count,
+        #[inline(always)]
+        |block| block.intersect::<LEAF, ANY, PLAIN>(ray, &wray, count, t_max, filter),
     )
 }
 

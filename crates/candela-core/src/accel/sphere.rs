@@ -18,7 +18,12 @@ use crate::geometry::Ray;
 /// [`intersect_sphere`] on `V::LANES` spheres: `centre` the rows of their centres'
 /// x, y and z, `radius` the row of their radii. Returns the lanes hit within
 /// (ε, t_max) as all-ones lanes, and there the distance, the nearer root where it is in
-/// range, else the farther one. Other lanes' distances are unspecified.
+/// range, else the farther one. Other lanes' distances are unspecified. Lanes outside
+/// `lanes` (bit i for lane i) may be reported hit: the caller masks them off.
+///
+/// Where no lane of `lanes` has a discriminant ≥ 0 (the ray misses every sphere: the
+/// scalar test's early `None`), the roots are not computed and no lane is hit (about
+/// 30 of the test's 75 instructions; most sphere lanes a ray meets are misses).
 ///
 /// # Safety
 /// The CPU must support `V`, and each row must hold `V::LANES` readable floats.
@@ -28,6 +33,7 @@ pub(super) unsafe fn intersect_spheres<V: Wide>(
     centre: [*const f32; 3],
     radius: *const f32,
     t_max: f32,
+    lanes: u32,
 ) -> (V, V) {
     let d = ray.d;
     // The ray's terms are the scalar test's own scalars, splatted.
@@ -47,10 +53,13 @@ pub(super) unsafe fn intersect_spheres<V: Wide>(
     let vz = oz.sub(s.mul(dz));
     let len = vx.mul(vx).add(vy.mul(vy)).add(vz.mul(vz)).sqrt();
     let discrim = V::splat(4.0 * a).mul(r.add(len)).mul(r.sub(len));
+    let zero = V::splat(0.0);
+    if discrim.ge(zero).bits() & lanes == 0 {
+        return (zero, zero);
+    }
     // A negative discriminant's root is NaN, and so are both distances, which no
     // comparison below passes: the scalar test's early `None`.
     let root = discrim.sqrt();
-    let zero = V::splat(0.0);
     let half = V::splat(-0.5);
     let q = b
         .lt(zero)

@@ -133,6 +133,7 @@ pub(super) fn to_world(local: MeshDesc, m: Mat4, material: MaterialId) -> Mesh {
         flip_normals: false,
         alpha: None,
         face_normals: Vec::new(),
+        face_dpdu: Vec::new(),
     }
 }
 
@@ -152,6 +153,7 @@ pub(super) fn object_space(local: MeshDesc, material: MaterialId) -> Mesh {
         flip_normals: false,
         alpha: None,
         face_normals: Vec::new(),
+        face_dpdu: Vec::new(),
     }
 }
 

@@ -59,7 +59,7 @@ impl Ray8 {
 /// and NaN otherwise, so one sum tests all six (a third of the instructions of six
 /// `is_finite`s and no branches; callgrind, Cornell render).
 #[inline(always)]
-fn finite(ray: &Ray) -> bool {
+pub(crate) fn finite(ray: &Ray) -> bool {
     let z = ray.o * 0.0 + ray.d * 0.0;
     z.x + z.y + z.z == 0.0
 }

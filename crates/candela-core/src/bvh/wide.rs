@@ -301,6 +301,20 @@ impl<N: WideNode> WideBvh<N> {
         self.bounds
     }
 
+    /// The leaf (as its lane names it, and its primitive count) when the tree is one
+    /// node over one leaf: every primitive fits one leaf, and a traversal needs no box
+    /// test (which only culls) to find that leaf's hits.
+    pub fn sole_leaf(&self) -> Option<(u32, u32)> {
+        let [root] = &self.nodes[..] else {
+            return None;
+        };
+        let (child, count, leaves) = root.links();
+        (leaves.count_ones() == 1).then(|| {
+            let lane = leaves.trailing_zeros() as usize;
+            (child[lane], count[lane] as u32)
+        })
+    }
+
     /// Finds the nearest hit. `leaf(first, count, t_max)` tests the leaf's primitives
     /// and returns the distance of the nearest one hit before `t_max` (or `t_max`);
     /// `prefetch_leaf(first)` is called when a leaf is put off for later, so that the

@@ -164,15 +164,10 @@ fn full_triangle_interaction(
         (t.truncate(), if t.w < 0.0 { -1.0 } else { 1.0 })
     } else if m.uvs.is_empty() {
         (p1 - p0, 1.0)
+    } else if let (None, Some(&f)) = (inst, m.face_dpdu.get(tri as usize)) {
+        (f.truncate(), f.w)
     } else {
-        let (dpdu, dpdv) = triangle_dpdu_dpdv([p0, p1, p2], [m.uvs[a], m.uvs[b], m.uvs[c]]);
-        // Mirrored uvs: +v lies against ng × ∂p/∂u.
-        let sign = if ng.cross(dpdu).dot(dpdv) < 0.0 {
-            -1.0
-        } else {
-            1.0
-        };
-        (dpdu, sign)
+        uv_tangent([p0, p1, p2], [m.uvs[a], m.uvs[b], m.uvs[c]], ng)
     };
     let color = if m.colors.is_empty() {
         Vec3::ONE
@@ -216,6 +211,19 @@ fn bare_triangle_interaction(m: &Mesh, tri: u32, t: f32, bary: Vec2) -> SurfaceI
     }
 }
 
+/// ∂p/∂u of a triangle from its positions `p` and uvs, and the bitangent sign against its
+/// geometric normal `ng`: −1 where the uvs are mirrored (+v lies against ng × ∂p/∂u).
+#[inline]
+pub(super) fn uv_tangent(p: [Vec3; 3], uv: [Vec2; 3], ng: Vec3) -> (Vec3, f32) {
+    let (dpdu, dpdv) = triangle_dpdu_dpdv(p, uv);
+    let sign = if ng.cross(dpdu).dot(dpdv) < 0.0 {
+        -1.0
+    } else {
+        1.0
+    };
+    (dpdu, sign)
+}
+
 /// ∂p/∂u and ∂p/∂v of a triangle from its positions and uvs (pbrt-v4 §6.5.3); zero when
 /// the uvs are degenerate.
 fn triangle_dpdu_dpdv(p: [Vec3; 3], uv: [Vec2; 3]) -> (Vec3, Vec3) {
@@ -252,6 +260,7 @@ mod tests {
             flip_normals: false,
             alpha: None,
             face_normals: vec![],
+            face_dpdu: vec![],
         }
     }
 
@@ -320,5 +329,56 @@ mod tests {
                 .collect();
             assert_eq!(cached, computed);
         }
+    }
+
+    /// A mesh with uvs: the cached ∂p/∂u and bitangent signs give the records the uvs
+    /// give, bit for bit, on a plain, a mirrored and a degenerate uv triangle, with and
+    /// without `flip_normals`; a mesh with tangents caches none (its tangents rule).
+    #[test]
+    fn cached_uv_tangents_give_the_computed_records() {
+        let mut m = mesh(
+            vec![
+                Vec3::new(0.1, 0.2, 0.3),
+                Vec3::new(1.7, -0.4, 0.2),
+                Vec3::new(0.3, 1.1, -0.9),
+                Vec3::new(-0.5, 0.6, 2.0),
+            ],
+            vec![Vec3::new(0.2, 0.9, 0.1).normalize(); 4],
+            vec![[0, 1, 2], [2, 1, 3], [0, 3, 1]],
+        );
+        // Triangle 1 mirrors triangle 0's uv winding; triangle 2's uvs are collinear.
+        m.uvs = vec![
+            Vec2::new(0.0, 0.0),
+            Vec2::new(1.0, 0.0),
+            Vec2::new(0.0, 1.0),
+            Vec2::new(2.0, 0.0),
+        ];
+        let mut signs = Vec::new();
+        for flip in [false, true] {
+            m.flip_normals = flip;
+            m.face_normals.clear();
+            m.face_dpdu.clear();
+            let records = |m: &Mesh| {
+                let mut r = Vec::new();
+                for tri in 0..3 {
+                    for bary in [Vec2::new(0.2, 0.3), Vec2::ZERO] {
+                        r.push(format!(
+                            "{:?}",
+                            full_triangle_interaction(m, None, tri, 1.5, bary)
+                        ));
+                    }
+                }
+                r
+            };
+            let computed = records(&m);
+            m.cache_face_normals();
+            assert_eq!(m.face_dpdu.len(), 3);
+            assert_eq!(records(&m), computed);
+            signs.extend(m.face_dpdu.iter().map(|f| f.w));
+        }
+        assert!(signs.contains(&1.0) && signs.contains(&-1.0), "{signs:?}");
+        m.tangents = vec![glam::Vec4::new(1.0, 0.0, 0.0, 1.0); 4];
+        m.cache_face_normals();
+        assert!(m.face_dpdu.is_empty());
     }
 }

@@ -108,14 +108,21 @@ impl Scene {
     }
 
     /// Whether anything lies on the ray within (0, t_max).
-    #[inline]
+    ///
+    /// Inlined, with the instances out of line (as in [`Scene::intersect`]).
+    #[inline(always)]
     pub fn occluded(&self, ray: &Ray, t_max: f32) -> bool {
         self.accel
             .occluded(ray, t_max, |i, hit| self.alpha_accepts(i, hit, ray))
-            || (!self.instances.is_empty()
-                && self.instances.occluded(ray, t_max, |inst, tri, hit| {
-                    self.instance_alpha_accepts(inst, tri, hit, ray)
-                }))
+            || (!self.instances.is_empty() && self.occluded_instances(ray, t_max))
+    }
+
+    /// Whether an instanced surface lies on the ray within (0, t_max).
+    #[inline(never)]
+    fn occluded_instances(&self, ray: &Ray, t_max: f32) -> bool {
+        self.instances.occluded(ray, t_max, |inst, tri, hit| {
+            self.instance_alpha_accepts(inst, tri, hit, ray)
+        })
     }
 
     /// Whether the segment from surface point `from` (normal `n_from`) to point `to`
