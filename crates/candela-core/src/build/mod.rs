@@ -20,7 +20,7 @@ use std::sync::Arc;
 use glam::Vec3;
 
 use crate::accel::{
-    Accel, AccelLayout, Geometry, LeafLayout, NodeLayout, Shape, Simd, TriangleMesh,
+    Accel, AccelLayout, Geometry, LeafLayout, NodeLayout, Shape, Simd, TriangleMesh, INDEXED_FROM,
 };
 use crate::desc::{GeometryDesc, MeshDesc, RenderSettings, SceneDesc, Span};
 use crate::geometry::Aabb;
@@ -29,7 +29,7 @@ use crate::light::{Light, LightId, SphereLight};
 use crate::light_sampler::LightSampler;
 use crate::material::MaterialId;
 use crate::options::RenderOptions;
-use crate::scene::{Prim, Scene, Sphere};
+use crate::scene::{Mesh, Prim, Scene, Sphere};
 
 mod camera;
 mod environment;
@@ -206,6 +206,9 @@ fn build_taking(desc: &SceneDesc, mut taken: Vec<Option<MeshDesc>>) -> Result<Sc
     }
 
     let triangles: usize = meshes.iter().map(|m| m.indices.len()).sum();
+    if triangles + spheres.len() < INDEXED_FROM {
+        meshes.iter_mut().for_each(Mesh::cache_uv_tangents);
+    }
     let mut prims = Vec::with_capacity(triangles + spheres.len());
     for (mi, m) in meshes.iter().enumerate() {
         prims.extend((0..m.indices.len() as u32).map(|tri| Prim::Triangle {

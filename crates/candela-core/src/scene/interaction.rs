@@ -372,13 +372,14 @@ mod tests {
             };
             let computed = records(&m);
             m.cache_face_normals();
+            m.cache_uv_tangents();
             assert_eq!(m.face_dpdu.len(), 3);
             assert_eq!(records(&m), computed);
             signs.extend(m.face_dpdu.iter().map(|f| f.w));
         }
         assert!(signs.contains(&1.0) && signs.contains(&-1.0), "{signs:?}");
         m.tangents = vec![glam::Vec4::new(1.0, 0.0, 0.0, 1.0); 4];
-        m.cache_face_normals();
+        m.cache_uv_tangents();
         assert!(m.face_dpdu.is_empty());
     }
 }

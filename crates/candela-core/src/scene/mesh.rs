@@ -33,7 +33,7 @@ pub struct Mesh {
     /// division on the path's critical chain. Bit for bit what the hit would compute.
     pub face_normals: Vec<Vec3>,
     /// Empty, or each triangle's ∂p/∂u (xyz) and bitangent sign (w) from its uvs, as the
-    /// hit record makes them, cached by [`Mesh::cache_face_normals`] for a world-space
+    /// hit record makes them, cached by [`Mesh::cache_uv_tangents`] for a world-space
     /// mesh with uvs and no tangents: a hit then loads them instead of dividing two
     /// vectors by the uv determinant and taking a cross product (about 120 of the ~390
     /// instructions of such a mesh's hit record). Bit for bit what the hit would compute.
@@ -84,14 +84,21 @@ impl Mesh {
         self.winding_normal_of(tri)
     }
 
-    /// Fills [`Mesh::face_normals`] and, for a mesh with uvs and no tangents,
-    /// [`Mesh::face_dpdu`]; to be called after the last change to the positions, normals,
-    /// uvs, tangents, indices or `flip_normals` of a world-space mesh (as
+    /// Fills [`Mesh::face_normals`]; to be called after the last change to the positions,
+    /// normals, indices or `flip_normals` of a world-space mesh (as
     /// [`crate::build::build`] does).
     pub fn cache_face_normals(&mut self) {
         self.face_normals = (0..self.indices.len() as u32)
             .map(|tri| self.winding_normal_of(tri))
             .collect();
+    }
+
+    /// Fills [`Mesh::face_dpdu`] for a mesh with uvs and no tangents (else leaves it
+    /// empty), after [`Mesh::cache_face_normals`] and the last change to the uvs or
+    /// tangents. It costs 16 bytes a triangle, so [`crate::build::build`] caches it only
+    /// below [`crate::accel::INDEXED_FROM`] primitives, where a scene is not yet big
+    /// enough for its memory to be saved first.
+    pub fn cache_uv_tangents(&mut self) {
         self.face_dpdu = if self.uvs.is_empty() || !self.tangents.is_empty() {
             Vec::new()
         } else {
@@ -100,7 +107,7 @@ impl Mesh {
                     let [a, b, c] = self.indices[tri].map(|i| i as usize);
                     let uv = [self.uvs[a], self.uvs[b], self.uvs[c]];
                     let p = self.vertices(tri as u32);
-                    let (dpdu, sign) = uv_tangent(p, uv, self.face_normals[tri]);
+                    let (dpdu, sign) = uv_tangent(p, uv, self.geometric_normal(tri as u32));
                     dpdu.extend(sign)
                 })
                 .collect()
