@@ -1,0 +1,285 @@
+//! The lanes integrator: eight paths at a time, one per SIMD lane, each lane refilled with
+//! the band's next pixel sample as soon as its path ends (path regeneration, Novák et al.
+//! 2010), so the lanes stay busy while paths of different lengths finish.
+//!
+//! It estimates what the path integrator ([`super::path`]) does, with the same numbers: each
+//! lane has its own sampler, positioned at its pixel sample as the path integrator's is,
+//! and draws the same dimensions in the same order. Each bounce runs in two stages:
+//! - per lane, scalar (`shade_lane`): the bounce's numbers, the closest hit, emission
+//!   found, the BSDF at the hit, next event estimation, and the direction of every lobe
+//!   but the Lambertian one;
+//! - in lanes (`advance`): the Lambertian lobe's directions ([`diffuse`]), the throughput
+//!   update and Russian roulette, for all eight paths at once.
+//!
+//! The radiance of each pixel sample is kept and handed to the sink in the band's order
+//! once the band is done, so the image does not depend on the order in which lanes
+//! finish; it equals the path integrator's wherever the lanes compute what the scalar code
+//! does bit for bit. Scenes with media are not covered: they take the path integrator's
+//! volumetric loop ([`lanes_fallback`] says so).
+//!
+//! One concern per file: `simd` (the lane types), `state` (the paths' state in lanes),
+//! `diffuse` (the Lambertian lobe in lanes), here the bounce loop and its lane refill.
+
+mod diffuse;
+mod simd;
+mod state;
+
+use glam::{UVec2, Vec2, Vec3};
+
+use self::diffuse::DiffuseLanes;
+use self::simd::{F32x8, M32x8, Vec3x8, LANES};
+use self::state::PathLanes;
+use super::band::{camera_ray, Band, SampleSink};
+use super::direct::NeeVertex;
+use super::path::{add_emitted, add_escaped, direct, hides_emitter, BounceSamples};
+use super::RenderStats;
+use crate::bsdf::Lobe;
+use crate::light::ShadingCtx;
+use crate::options::IntegratorKind;
+use crate::sampler::Sampler;
+use crate::scene::Scene;
+
+/// Why the lanes integrator, where a scene asks for it, does not render it: `None` where
+/// it does (or where the scene asks for the path integrator).
+pub fn lanes_fallback(scene: &Scene) -> Option<&'static str> {
+    (scene.settings.integrator == IntegratorKind::Lanes && scene.media.is_some())
+        .then_some("scenes with participating media are not covered by the lanes integrator")
+}
+
+/// What one bounce's scalar stage leaves for the lane stage, lane by lane.
+struct BounceLanes {
+    /// Lanes whose vertex scatters: the path goes on if its direction is valid.
+    shaded: [bool; LANES],
+    /// Shaded lanes with a Lambertian BSDF: `lambert` holds them and the lane stage
+    /// samples their direction from `u_dir`.
+    diffuse: [bool; LANES],
+    /// The BSDF's shading normal of every shaded lane, and the rest of the Lambertian
+    /// lanes' BSDF.
+    lambert: DiffuseLanes,
+    u_dir: [F32x8; 2],
+    /// The direction, value and density the scalar code sampled in the other shaded lanes.
+    f: Vec3x8,
+    wi: Vec3x8,
+    pdf: F32x8,
+    /// Whether that direction came from a delta lobe.
+    delta: [bool; LANES],
+    /// η′² of the crossing (1 where the direction does not refract).
+    eta_crossed_sq: F32x8,
+    /// Lanes where Russian roulette plays after this bounce, and their numbers.
+    roulette: [bool; LANES],
+    u_rr: F32x8,
+}
+
+impl BounceLanes {
+    fn new() -> BounceLanes {
+        BounceLanes {
+            shaded: [false; LANES],
+            diffuse: [false; LANES],
+            lambert: DiffuseLanes {
+                ns: Vec3x8::ZERO,
+                ng: Vec3x8::ZERO,
+                wo: Vec3x8::ZERO,
+                albedo: Vec3x8::ZERO,
+                one_sided: M32x8::NONE,
+            },
+            u_dir: [F32x8::ZERO; 2],
+            f: Vec3x8::ZERO,
+            wi: Vec3x8::ZERO,
+            pdf: F32x8::ONE,
+            delta: [false; LANES],
+            eta_crossed_sq: F32x8::ONE,
+            roulette: [false; LANES],
+            u_rr: F32x8::ZERO,
+        }
+    }
+}
+
+/// Takes a band's samples with the lanes integrator; inlined into each copy of the render
+/// loop, as [`super::band::render_pixels`]. `V3`: whether this is the x86-64-v3 copy.
+#[inline(always)]
+pub(super) fn render_lanes<S: Sampler, K: SampleSink, const V3: bool>(
+    scene: &Scene,
+    sampler: &mut S,
+    band: Band,
+    sink: &mut K,
+) -> RenderStats {
+    let Band { rows, width, pass } = band;
+    let spp = pass.len();
+    let total = rows.len() * width as usize * spp;
+    // Pixel sample `k` of the band: pixel-major, as `render_pixels` takes them.
+    let sample_at = |k: usize| {
+        let pixel = (k / spp) as u32;
+        let p = UVec2::new(pixel % width, rows.start + pixel / width);
+        (p, pass.start + (k % spp) as u32)
+    };
+    let mut results = vec![(Vec2::ZERO, Vec3::ZERO); total];
+    let mut stats = RenderStats {
+        paths: total as u64,
+        rays: 0,
+    };
+    let mut lanes = PathLanes::new(sampler);
+    let mut next = 0;
+    let mut refill = |lanes: &mut PathLanes<S>, i: usize| {
+        if next == total {
+            lanes.slot[i] = None;
+            return;
+        }
+        let (p, index) = sample_at(next);
+        let (film_pos, ray) = camera_ray(scene, &mut lanes.samplers[i], p, index, K::SPLATS);
+        lanes.start(i, next, film_pos, ray);
+        next += 1;
+    };
+    for i in 0..LANES {
+        refill(&mut lanes, i);
+    }
+    while lanes.slot.iter().any(Option::is_some) {
+        let mut b = BounceLanes::new();
+        for i in 0..LANES {
+            if lanes.slot[i].is_some() {
+                b.shaded[i] = shade_lane::<S, V3>(scene, &mut lanes, &mut b, i, &mut stats.rays);
+            }
+        }
+        let alive = advance(&mut lanes, &mut b);
+        for i in 0..LANES {
+            let Some(slot) = lanes.slot[i] else {
+                continue;
+            };
+            if alive.get(i) {
+                let si = lanes.hit[i].as_ref().expect("a shaded lane has a hit");
+                lanes.ray[i] = si.spawn_ray(b.wi.lane(i));
+                lanes.specular[i] = b.delta[i];
+                lanes.prev[i].bsdf_pdf = b.pdf.0[i];
+                lanes.depth[i] += 1;
+            } else {
+                results[slot] = (lanes.film_pos[i], lanes.l[i]);
+                refill(&mut lanes, i);
+            }
+        }
+    }
+    for (k, &(film_pos, l)) in results.iter().enumerate() {
+        sink.add(sample_at(k).0, film_pos, l);
+    }
+    stats
+}
+
+/// The scalar stage of lane `i`'s bounce, as the path integrator's loop body up to the
+/// throughput update: draws the bounce's numbers, traces the lane's ray, adds the emission
+/// found and next event estimation to its radiance, and leaves in `b` what the lane stage
+/// needs to continue the path. Returns whether the path scatters here (else it ends).
+#[inline(always)]
+fn shade_lane<S: Sampler, const V3: bool>(
+    scene: &Scene,
+    lanes: &mut PathLanes<S>,
+    b: &mut BounceLanes,
+    i: usize,
+    rays: &mut u64,
+) -> bool {
+    *rays += 1;
+    let depth = lanes.depth[i];
+    let sampler = &mut lanes.samplers[i];
+    let u = (depth < scene.settings.max_depth).then(
+        #[inline(always)]
+        || BounceSamples::<S>::draw(scene, sampler),
+    );
+    let ray = lanes.ray[i];
+    lanes.hit[i] = scene.intersect(&ray, f32::INFINITY);
+    let hit = lanes.hit[i].as_ref();
+    if hides_emitter(scene, depth, hit) {
+        return false;
+    }
+    let (specular, prev, beta) = (lanes.specular[i], lanes.prev[i], lanes.beta.lane(i));
+    let l = &mut lanes.l[i];
+    let Some(si) = hit else {
+        add_escaped(scene, &ray, depth, specular, &prev, beta, l);
+        return false;
+    };
+    let wo = -ray.d;
+    add_emitted(scene, si, &ray, specular, &prev, beta, l);
+    let Some(u) = u else {
+        return false;
+    };
+
+    let bsdf = scene.materials[si.material.0 as usize].bsdf_at(si);
+    let ctx = ShadingCtx { p: si.p, n: si.ns };
+    b.lambert.ns.set_lane(i, bsdf.frame.n);
+    let sampled = match bsdf.lobe {
+        Lobe::Diffuse(d) => {
+            b.diffuse[i] = true;
+            b.lambert.ng.set_lane(i, bsdf.ng);
+            b.lambert.wo.set_lane(i, wo);
+            b.lambert.albedo.set_lane(i, d.albedo);
+            b.lambert.one_sided.0[i] = if bsdf.one_sided { u32::MAX } else { 0 };
+            (b.u_dir[0].0[i], b.u_dir[1].0[i]) = (u.dir.x, u.dir.y);
+            None
+        }
+        _ => {
+            let u_lobe = if bsdf.lobe.takes_lobe_sample() {
+                sampler.resolve_1d(u.lobe)
+            } else {
+                0.5
+            };
+            Some(bsdf.sample(wo, u_lobe, u.dir))
+        }
+    };
+    if !bsdf.is_delta() {
+        let v = NeeVertex {
+            si,
+            ctx: &ctx,
+            bsdf: &bsdf,
+            wo,
+            u_light: u.light,
+            u_point: u.point,
+        };
+        *l += beta * direct::<V3>(scene, &v, rays);
+    }
+    match sampled {
+        None => {}
+        Some(None) => return false,
+        Some(Some(bs)) => {
+            b.f.set_lane(i, bs.f);
+            b.wi.set_lane(i, bs.wi);
+            b.pdf.0[i] = bs.pdf;
+            b.delta[i] = bs.flags.is_delta();
+            b.eta_crossed_sq.0[i] = bsdf.eta_crossed_sq(wo, &bs);
+        }
+    }
+    lanes.prev[i].ctx = ctx;
+    if depth + 1 < scene.settings.rr_depth {
+        sampler.skip_1d();
+    } else {
+        b.roulette[i] = true;
+        b.u_rr.0[i] = sampler.get_1d();
+    }
+    true
+}
+
+/// The lane stage of a bounce: the Lambertian lanes' directions, then for every shaded lane
+/// the throughput update and Russian roulette, as the path integrator's loop does them.
+/// Leaves every shaded lane's direction and density in `b` and returns the lanes whose
+/// paths go on.
+#[inline(always)]
+fn advance<S>(lanes: &mut PathLanes<S>, b: &mut BounceLanes) -> M32x8 {
+    let diffuse = M32x8::from_bools(b.diffuse);
+    let lambert = diffuse::sample(&b.lambert, b.u_dir[0], b.u_dir[1]);
+    let f = Vec3x8::select(diffuse, &lambert.f, &b.f);
+    b.wi = Vec3x8::select(diffuse, &lambert.wi, &b.wi);
+    b.pdf = diffuse.select(lambert.pdf, b.pdf);
+    let sampled = M32x8::from_bools(b.shaded).and(diffuse.not().or(lambert.ok));
+
+    let cos = b.wi.dot(&b.lambert.ns).abs();
+    let beta = lanes.beta.mul(&f.scale(cos / b.pdf));
+    let eta_scale = lanes.eta_scale * b.eta_crossed_sq;
+    // Survival in proportion to the throughput (see `path::li_isa`).
+    let one = F32x8::ONE;
+    let q = (one - beta.max_component() * eta_scale).max(F32x8::ZERO);
+    let roulette = M32x8::from_bools(b.roulette);
+    let killed = roulette.and(b.u_rr.lt(q));
+    let beta = Vec3x8::select(roulette, &beta.scale(one / (one - q)), &beta);
+    let alive = sampled
+        .and(killed.not())
+        .and(beta.is_zero().not())
+        .and(beta.is_finite());
+    lanes.beta = Vec3x8::select(sampled, &beta, &lanes.beta);
+    lanes.eta_scale = sampled.select(eta_scale, lanes.eta_scale);
+    alive
+}
