@@ -7,72 +7,70 @@
 
 use std::f32::consts::{FRAC_1_PI, FRAC_PI_4};
 
-use super::simd::{F32x8, M32x8, Vec3x8};
+use super::simd::{F32x8, LaneIsa, Lanes32, M32x8, Vec3Lanes, Vec3x8, LANES};
 
-/// What eight Lambertian shading points give their sampler: the shading normal (the
-/// frame's z), the geometric normal, the direction towards the previous vertex and the
-/// albedo, lane by lane.
+/// What eight Lambertian shading points give their sampler, in memory: the shading normal
+/// (the frame's z), the geometric normal, the direction towards the previous vertex and
+/// the albedo, lane by lane.
 #[derive(Clone, Copy, Debug)]
 pub(super) struct DiffuseLanes {
-    pub ns: Vec3x8,
-    pub ng: Vec3x8,
-    pub wo: Vec3x8,
-    pub albedo: Vec3x8,
+    pub ns: Vec3Lanes,
+    pub ng: Vec3Lanes,
+    pub wo: Vec3Lanes,
+    pub albedo: Vec3Lanes,
     /// Lanes whose BSDF is black from below (one-sided).
-    pub one_sided: M32x8,
+    pub one_sided: [bool; LANES],
 }
 
 /// Sampled directions of eight lanes: in the lanes of `ok`, `f`, `wi` and `pdf` are those of
 /// the scalar [`crate::bsdf::BsdfSample`]; elsewhere the scalar code returned no sample
 /// and the values mean nothing.
-#[derive(Clone, Copy, Debug)]
-pub(super) struct SampledLanes {
-    pub f: Vec3x8,
-    pub wi: Vec3x8,
-    pub pdf: F32x8,
-    pub ok: M32x8,
+#[derive(Clone, Copy)]
+pub(super) struct SampledLanes<I: LaneIsa> {
+    pub f: Vec3x8<I>,
+    pub wi: Vec3x8<I>,
+    pub pdf: F32x8<I>,
+    pub ok: M32x8<I>,
 }
 
 /// Shirley and Chiu's concentric map of `u` in [0,1)² to the unit disk, lane by lane, as
 /// [`crate::sampling::sample_concentric_disk`].
 #[inline(always)]
-fn concentric_disk(ux: F32x8, uy: F32x8) -> (F32x8, F32x8) {
-    let two = F32x8::splat(2.0);
-    let (ox, oy) = (two * ux - F32x8::ONE, two * uy - F32x8::ONE);
+fn concentric_disk<I: LaneIsa>(ux: F32x8<I>, uy: F32x8<I>) -> (F32x8<I>, F32x8<I>) {
+    let (one, two, zero) = (F32x8::splat(1.0), F32x8::splat(2.0), F32x8::splat(0.0));
+    let (ox, oy) = (two * ux - one, two * uy - one);
     let x_wide = ox.abs().gt(oy.abs());
     let r = x_wide.select(ox, oy);
     let a = F32x8::splat(FRAC_PI_4) * (x_wide.select(oy, ox) / r);
     let (s, c) = sin_cos_quarter(a);
     let (dx, dy) = (r * x_wide.select(c, s), r * x_wide.select(s, c));
-    let centre = ox.eq(F32x8::ZERO).and(oy.eq(F32x8::ZERO));
-    (
-        centre.select(F32x8::ZERO, dx),
-        centre.select(F32x8::ZERO, dy),
-    )
+    let centre = ox.eq(zero).and(oy.eq(zero));
+    (centre.select(zero, dx), centre.select(zero, dy))
 }
 
 /// [`crate::sampling::sin_cos_quarter`] lane by lane.
 #[inline(always)]
-fn sin_cos_quarter(a: F32x8) -> (F32x8, F32x8) {
-    let k = F32x8::splat;
+fn sin_cos_quarter<I: LaneIsa>(a: F32x8<I>) -> (F32x8<I>, F32x8<I>) {
+    let k = F32x8::<I>::splat;
     let a2 = a * a;
     let s = a
         * (k(1.0)
             + a2 * (k(-1.0 / 6.0)
                 + a2 * (k(1.0 / 120.0) + a2 * (k(-1.0 / 5040.0) + a2 * k(1.0 / 362_880.0)))));
     let c = k(1.0)
-        + a2 * (k(-0.5) + a2 * (k(1.0 / 24.0) + a2 * (k(-1.0 / 720.0) + a2 * (k(1.0 / 40_320.0)))));
+        + a2 * (k(-0.5) + a2 * (k(1.0 / 24.0) + a2 * (k(-1.0 / 720.0) + a2 * k(1.0 / 40_320.0))));
     (s, c)
 }
 
 /// Duff et al.'s frame around `n` ([`crate::math::Frame::from_z`]): its first two axes.
 #[inline(always)]
-fn frame_from_z(n: &Vec3x8) -> (Vec3x8, Vec3x8) {
-    let sign = F32x8::ONE.copysign(n.z);
-    let a = -F32x8::ONE / (sign + n.z);
+fn frame_from_z<I: LaneIsa>(n: &Vec3x8<I>) -> (Vec3x8<I>, Vec3x8<I>) {
+    let one = F32x8::splat(1.0);
+    let sign = one.copysign(n.z);
+    let a = -one / (sign + n.z);
     let b = n.x * n.y * a;
     let s = Vec3x8 {
-        x: F32x8::ONE + sign * n.x * n.x * a,
+        x: one + sign * n.x * n.x * a,
         y: sign * b,
         z: -sign * n.x,
     };
@@ -88,26 +86,35 @@ fn frame_from_z(n: &Vec3x8) -> (Vec3x8, Vec3x8) {
 /// lane), with the Lambertian value and density: the scalar `Bsdf::sample` of a diffuse
 /// lobe, lane by lane.
 #[inline(always)]
-pub(super) fn sample(d: &DiffuseLanes, ux: F32x8, uy: F32x8) -> SampledLanes {
-    let zero = F32x8::ZERO;
-    let cos_o = d.wo.dot(&d.ns);
-    let blind = cos_o.eq(zero).or(d.one_sided.and(cos_o.lt(zero)));
-    let (lx, ly) = concentric_disk(ux, uy);
-    let lz = (F32x8::ONE - (lx * lx + ly * ly)).max(zero).sqrt();
+pub(super) fn sample<I: LaneIsa>(d: &DiffuseLanes, u: &[Lanes32; 2]) -> SampledLanes<I> {
+    let zero = F32x8::splat(0.0);
+    let (ns, ng, wo) = (
+        Vec3x8::load(&d.ns),
+        Vec3x8::load(&d.ng),
+        Vec3x8::load(&d.wo),
+    );
+    let cos_o = wo.dot(&ns);
+    let one_sided = M32x8::from_bools(d.one_sided);
+    let blind = cos_o.eq(zero).or(one_sided.and(cos_o.lt(zero)));
+    let (lx, ly) = concentric_disk(F32x8::load(&u[0]), F32x8::load(&u[1]));
+    let lz = (F32x8::splat(1.0) - (lx * lx + ly * ly)).max(zero).sqrt();
     let lz = cos_o.lt(zero).select(-lz, lz);
     let pdf = lz.abs().max(zero) * F32x8::splat(FRAC_1_PI);
-    let f = d.albedo.scale(F32x8::splat(FRAC_1_PI));
-    let (s, t) = frame_from_z(&d.ns);
+    let f = Vec3x8::load(&d.albedo).scale(F32x8::splat(FRAC_1_PI));
+    let (s, t) = frame_from_z(&ns);
     let wi = Vec3x8 {
-        x: s.x * lx + t.x * ly + d.ns.x * lz,
-        y: s.y * lx + t.y * ly + d.ns.y * lz,
-        z: s.z * lx + t.z * ly + d.ns.z * lz,
+        x: s.x * lx + t.x * ly + ns.x * lz,
+        y: s.y * lx + t.y * ly + ns.y * lz,
+        z: s.z * lx + t.z * ly + ns.z * lz,
     };
     // Reflection for the geometric normal exactly where it is for the shading normal.
-    let geometric = (d.wo.dot(&d.ng) * wi.dot(&d.ng)).gt(zero);
+    let geometric = (wo.dot(&ng) * wi.dot(&ng)).gt(zero);
     let shading = (cos_o * lz).gt(zero);
-    let agree = M32x8(std::array::from_fn(|i| !(geometric.0[i] ^ shading.0[i])));
-    let ok = blind.not().and(pdf.gt(zero)).and(f.is_finite()).and(agree);
+    let ok = blind
+        .not()
+        .and(pdf.gt(zero))
+        .and(f.is_finite())
+        .and(geometric.xor(shading).not());
     SampledLanes { f, wi, pdf, ok }
 }
 
@@ -115,7 +122,7 @@ pub(super) fn sample(d: &DiffuseLanes, ux: F32x8, uy: F32x8) -> SampledLanes {
 mod tests {
     use glam::{Vec2, Vec3};
 
-    use super::super::simd::LANES;
+    use super::super::simd::Portable;
     use super::*;
     use crate::bsdf::{Bsdf, Diffuse, Lobe};
     use crate::sampler::{IndependentSampler, Sampler};
@@ -124,8 +131,7 @@ mod tests {
     /// it rejects are the ones the scalar code gives no sample for, over 4096 random
     /// configurations (normals bent from the geometric one, both sides, one-sided BSDFs,
     /// and the disk's centre and edges among the numbers).
-    #[test]
-    fn lanes_sample_as_the_scalar_bsdf() {
+    fn lanes_sample_as_the_scalar_bsdf<I: LaneIsa>() {
         let mut rng = IndependentSampler::new(11);
         rng.start_pixel_sample(glam::UVec2::new(1, 2), 3);
         let dir =
@@ -134,13 +140,13 @@ mod tests {
         for round in 0..512 {
             let mut bsdfs = Vec::new();
             let mut lanes = DiffuseLanes {
-                ns: Vec3x8::ZERO,
-                ng: Vec3x8::ZERO,
-                wo: Vec3x8::ZERO,
-                albedo: Vec3x8::ZERO,
-                one_sided: M32x8::NONE,
+                ns: Vec3Lanes::ZERO,
+                ng: Vec3Lanes::ZERO,
+                wo: Vec3Lanes::ZERO,
+                albedo: Vec3Lanes::ZERO,
+                one_sided: [false; LANES],
             };
-            let (mut ux, mut uy) = (F32x8::ZERO, F32x8::ZERO);
+            let mut u_lanes = [[0.0; LANES]; 2];
             for i in 0..LANES {
                 let ng = dir(&mut rng);
                 let ns = (ng + 0.4 * dir(&mut rng)).normalize();
@@ -148,7 +154,7 @@ mod tests {
                 let albedo = Vec3::new(rng.get_1d(), rng.get_1d(), 0.5);
                 let mut bsdf = Bsdf::new(ns, ng, Lobe::Diffuse(Diffuse { albedo }));
                 bsdf.one_sided = (round + i) % 3 == 0;
-                lanes.one_sided.0[i] = if bsdf.one_sided { u32::MAX } else { 0 };
+                lanes.one_sided[i] = bsdf.one_sided;
                 let u = match (round + i) % 16 {
                     0 => Vec2::splat(0.5),
                     1 => Vec2::new(0.0, rng.get_1d()),
@@ -158,24 +164,34 @@ mod tests {
                 lanes.ng.set_lane(i, ng);
                 lanes.wo.set_lane(i, wo);
                 lanes.albedo.set_lane(i, albedo);
-                (ux.0[i], uy.0[i]) = (u.x, u.y);
+                let [ux, uy] = &mut u_lanes;
+                (ux[i], uy[i]) = (u.x, u.y);
                 bsdfs.push((bsdf, wo, u));
             }
-            let got = sample(&lanes, ux, uy);
+            let got = sample::<I>(&lanes, &u_lanes);
+            let (ok, wi, f, pdf) = (
+                got.ok.bits(),
+                got.wi.store(),
+                got.f.store(),
+                got.pdf.store(),
+            );
             for (i, (bsdf, wo, u)) in bsdfs.iter().enumerate() {
                 match bsdf.sample(*wo, 0.5, *u) {
                     Some(s) => {
-                        assert!(got.ok.get(i), "round {round} lane {i}: lanes rejected");
+                        assert!(ok & (1 << i) != 0, "round {round} lane {i}: lanes rejected");
                         assert_eq!(
-                            got.wi.lane(i).to_array().map(f32::to_bits),
+                            wi.lane(i).to_array().map(f32::to_bits),
                             s.wi.to_array().map(f32::to_bits)
                         );
-                        assert_eq!(got.f.lane(i), s.f);
-                        assert_eq!(got.pdf.0[i].to_bits(), s.pdf.to_bits());
+                        assert_eq!(f.lane(i), s.f);
+                        assert_eq!(pdf[i].to_bits(), s.pdf.to_bits());
                         checked += 1;
                     }
                     None => {
-                        assert!(!got.ok.get(i), "round {round} lane {i}: scalar rejected");
+                        assert!(
+                            ok & (1 << i) == 0,
+                            "round {round} lane {i}: scalar rejected"
+                        );
                         rejected += 1;
                     }
                 }
@@ -186,5 +202,25 @@ mod tests {
             checked > 1000 && rejected > 100,
             "{checked} sampled, {rejected} rejected"
         );
+    }
+
+    #[test]
+    fn portable_lanes_sample_as_the_scalar_bsdf() {
+        lanes_sample_as_the_scalar_bsdf::<Portable>();
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[test]
+    fn avx2_lanes_sample_as_the_scalar_bsdf() {
+        if !std::arch::is_x86_feature_detected!("avx2") {
+            eprintln!("NOTE: no AVX2 on this CPU: the AVX2 lanes are not tested");
+            return;
+        }
+        // SAFETY: the CPU has AVX2 (checked above).
+        #[target_feature(enable = "avx,avx2")]
+        unsafe fn run() {
+            lanes_sample_as_the_scalar_bsdf::<super::super::simd::Avx2>();
+        }
+        unsafe { run() }
     }
 }

@@ -27,7 +27,9 @@ mod state;
 use glam::{UVec2, Vec2, Vec3};
 
 use self::diffuse::DiffuseLanes;
-use self::simd::{F32x8, M32x8, Vec3x8, LANES};
+#[cfg(target_arch = "x86_64")]
+use self::simd::Avx2;
+use self::simd::{F32x8, LaneIsa, Lanes32, M32x8, Portable, Vec3Lanes, Vec3x8, LANES};
 use self::state::PathLanes;
 use super::band::{camera_ray, Band, SampleSink};
 use super::direct::NeeVertex;
@@ -56,18 +58,19 @@ struct BounceLanes {
     /// The BSDF's shading normal of every shaded lane, and the rest of the Lambertian
     /// lanes' BSDF.
     lambert: DiffuseLanes,
-    u_dir: [F32x8; 2],
-    /// The direction, value and density the scalar code sampled in the other shaded lanes.
-    f: Vec3x8,
-    wi: Vec3x8,
-    pdf: F32x8,
+    u_dir: [Lanes32; 2],
+    /// The direction, value and density the scalar code sampled in the other shaded
+    /// lanes; after the lane stage, every shaded lane's direction and density.
+    f: Vec3Lanes,
+    wi: Vec3Lanes,
+    pdf: Lanes32,
     /// Whether that direction came from a delta lobe.
     delta: [bool; LANES],
     /// η′² of the crossing (1 where the direction does not refract).
-    eta_crossed_sq: F32x8,
+    eta_crossed_sq: Lanes32,
     /// Lanes where Russian roulette plays after this bounce, and their numbers.
     roulette: [bool; LANES],
-    u_rr: F32x8,
+    u_rr: Lanes32,
 }
 
 impl BounceLanes {
@@ -76,20 +79,20 @@ impl BounceLanes {
             shaded: [false; LANES],
             diffuse: [false; LANES],
             lambert: DiffuseLanes {
-                ns: Vec3x8::ZERO,
-                ng: Vec3x8::ZERO,
-                wo: Vec3x8::ZERO,
-                albedo: Vec3x8::ZERO,
-                one_sided: M32x8::NONE,
+                ns: Vec3Lanes::ZERO,
+                ng: Vec3Lanes::ZERO,
+                wo: Vec3Lanes::ZERO,
+                albedo: Vec3Lanes::ZERO,
+                one_sided: [false; LANES],
             },
-            u_dir: [F32x8::ZERO; 2],
-            f: Vec3x8::ZERO,
-            wi: Vec3x8::ZERO,
-            pdf: F32x8::ONE,
+            u_dir: [[0.0; LANES]; 2],
+            f: Vec3Lanes::ZERO,
+            wi: Vec3Lanes::ZERO,
+            pdf: [1.0; LANES],
             delta: [false; LANES],
-            eta_crossed_sq: F32x8::ONE,
+            eta_crossed_sq: [1.0; LANES],
             roulette: [false; LANES],
-            u_rr: F32x8::ZERO,
+            u_rr: [0.0; LANES],
         }
     }
 }
@@ -139,16 +142,20 @@ pub(super) fn render_lanes<S: Sampler, K: SampleSink, const V3: bool>(
                 b.shaded[i] = shade_lane::<S, V3>(scene, &mut lanes, &mut b, i, &mut stats.rays);
             }
         }
-        let alive = advance(&mut lanes, &mut b);
+        let alive = match V3 {
+            #[cfg(target_arch = "x86_64")]
+            true => advance::<Avx2, S>(&mut lanes, &mut b),
+            _ => advance::<Portable, S>(&mut lanes, &mut b),
+        };
         for i in 0..LANES {
             let Some(slot) = lanes.slot[i] else {
                 continue;
             };
-            if alive.get(i) {
+            if alive & (1 << i) != 0 {
                 let si = lanes.hit[i].as_ref().expect("a shaded lane has a hit");
                 lanes.ray[i] = si.spawn_ray(b.wi.lane(i));
                 lanes.specular[i] = b.delta[i];
-                lanes.prev[i].bsdf_pdf = b.pdf.0[i];
+                lanes.prev[i].bsdf_pdf = b.pdf[i];
                 lanes.depth[i] += 1;
             } else {
                 results[slot] = (lanes.film_pos[i], lanes.l[i]);
@@ -208,8 +215,8 @@ fn shade_lane<S: Sampler, const V3: bool>(
             b.lambert.ng.set_lane(i, bsdf.ng);
             b.lambert.wo.set_lane(i, wo);
             b.lambert.albedo.set_lane(i, d.albedo);
-            b.lambert.one_sided.0[i] = if bsdf.one_sided { u32::MAX } else { 0 };
-            (b.u_dir[0].0[i], b.u_dir[1].0[i]) = (u.dir.x, u.dir.y);
+            b.lambert.one_sided[i] = bsdf.one_sided;
+            (b.u_dir[0][i], b.u_dir[1][i]) = (u.dir.x, u.dir.y);
             None
         }
         _ => {
@@ -238,9 +245,9 @@ fn shade_lane<S: Sampler, const V3: bool>(
         Some(Some(bs)) => {
             b.f.set_lane(i, bs.f);
             b.wi.set_lane(i, bs.wi);
-            b.pdf.0[i] = bs.pdf;
+            b.pdf[i] = bs.pdf;
             b.delta[i] = bs.flags.is_delta();
-            b.eta_crossed_sq.0[i] = bsdf.eta_crossed_sq(wo, &bs);
+            b.eta_crossed_sq[i] = bsdf.eta_crossed_sq(wo, &bs);
         }
     }
     lanes.prev[i].ctx = ctx;
@@ -248,38 +255,43 @@ fn shade_lane<S: Sampler, const V3: bool>(
         sampler.skip_1d();
     } else {
         b.roulette[i] = true;
-        b.u_rr.0[i] = sampler.get_1d();
+        b.u_rr[i] = sampler.get_1d();
     }
     true
 }
 
-/// The lane stage of a bounce: the Lambertian lanes' directions, then for every shaded lane
-/// the throughput update and Russian roulette, as the path integrator's loop does them.
-/// Leaves every shaded lane's direction and density in `b` and returns the lanes whose
-/// paths go on.
+/// The lane stage of a bounce on backend `I`: the Lambertian lanes' directions, then for
+/// every shaded lane the throughput update and Russian roulette, as the path integrator's
+/// loop does them. Leaves every shaded lane's direction and density in `b` and returns the
+/// lanes whose paths go on (bit `i` for lane `i`). `I` is [`Avx2`] only in the v3 copy of
+/// the render loop.
 #[inline(always)]
-fn advance<S>(lanes: &mut PathLanes<S>, b: &mut BounceLanes) -> M32x8 {
-    let diffuse = M32x8::from_bools(b.diffuse);
-    let lambert = diffuse::sample(&b.lambert, b.u_dir[0], b.u_dir[1]);
-    let f = Vec3x8::select(diffuse, &lambert.f, &b.f);
-    b.wi = Vec3x8::select(diffuse, &lambert.wi, &b.wi);
-    b.pdf = diffuse.select(lambert.pdf, b.pdf);
+fn advance<I: LaneIsa, S>(lanes: &mut PathLanes<S>, b: &mut BounceLanes) -> u8 {
+    let diffuse = M32x8::<I>::from_bools(b.diffuse);
+    let lambert = diffuse::sample::<I>(&b.lambert, &b.u_dir);
+    let f = Vec3x8::select(diffuse, &lambert.f, &Vec3x8::load(&b.f));
+    let wi = Vec3x8::select(diffuse, &lambert.wi, &Vec3x8::load(&b.wi));
+    let pdf = diffuse.select(lambert.pdf, F32x8::load(&b.pdf));
     let sampled = M32x8::from_bools(b.shaded).and(diffuse.not().or(lambert.ok));
 
-    let cos = b.wi.dot(&b.lambert.ns).abs();
-    let beta = lanes.beta.mul(&f.scale(cos / b.pdf));
-    let eta_scale = lanes.eta_scale * b.eta_crossed_sq;
+    let cos = wi.dot(&Vec3x8::load(&b.lambert.ns)).abs();
+    let old_beta = Vec3x8::load(&lanes.beta);
+    let beta = old_beta.mul(&f.scale(cos / pdf));
+    let old_eta_scale = F32x8::load(&lanes.eta_scale);
+    let eta_scale = old_eta_scale * F32x8::load(&b.eta_crossed_sq);
     // Survival in proportion to the throughput (see `path::li_isa`).
-    let one = F32x8::ONE;
-    let q = (one - beta.max_component() * eta_scale).max(F32x8::ZERO);
+    let one = F32x8::splat(1.0);
+    let q = (one - beta.max_component() * eta_scale).max(F32x8::splat(0.0));
     let roulette = M32x8::from_bools(b.roulette);
-    let killed = roulette.and(b.u_rr.lt(q));
+    let killed = roulette.and(F32x8::load(&b.u_rr).lt(q));
     let beta = Vec3x8::select(roulette, &beta.scale(one / (one - q)), &beta);
     let alive = sampled
         .and(killed.not())
         .and(beta.is_zero().not())
         .and(beta.is_finite());
-    lanes.beta = Vec3x8::select(sampled, &beta, &lanes.beta);
-    lanes.eta_scale = sampled.select(eta_scale, lanes.eta_scale);
-    alive
+    lanes.beta = Vec3x8::select(sampled, &beta, &old_beta).store();
+    lanes.eta_scale = sampled.select(eta_scale, old_eta_scale).store();
+    b.wi = wi.store();
+    b.pdf = pdf.store();
+    alive.bits()
 }

@@ -5,7 +5,7 @@
 
 use glam::{Vec2, Vec3};
 
-use super::simd::{F32x8, Vec3x8, LANES};
+use super::simd::{Lanes32, Vec3Lanes, LANES};
 use crate::geometry::Ray;
 use crate::integrator::path::PrevVertex;
 use crate::light::ShadingCtx;
@@ -28,9 +28,9 @@ pub(super) struct PathLanes<S> {
     /// Radiance gathered so far.
     pub l: [Vec3; LANES],
     /// Path throughput.
-    pub beta: Vec3x8,
+    pub beta: Vec3Lanes,
     /// The product of η′² over the refractions so far (see `Bsdf::eta_crossed_sq`).
-    pub eta_scale: F32x8,
+    pub eta_scale: Lanes32,
     /// Scattering events so far.
     pub depth: [u32; LANES],
     /// Whether the last bounce was a delta lobe (or the path just left the camera).
@@ -50,8 +50,8 @@ impl<S: Clone> PathLanes<S> {
             ray: [ray; LANES],
             hit: [None; LANES],
             l: [Vec3::ZERO; LANES],
-            beta: Vec3x8::ONE,
-            eta_scale: F32x8::ONE,
+            beta: Vec3Lanes::splat(Vec3::ONE),
+            eta_scale: [1.0; LANES],
             depth: [0; LANES],
             specular: [true; LANES],
             prev: [PrevVertex {
@@ -73,7 +73,7 @@ impl<S: Clone> PathLanes<S> {
         self.ray[i] = ray;
         self.l[i] = Vec3::ZERO;
         self.beta.set_lane(i, Vec3::ONE);
-        self.eta_scale.0[i] = 1.0;
+        self.eta_scale[i] = 1.0;
         self.depth[i] = 0;
         self.specular[i] = true;
         self.prev[i] = PrevVertex {
