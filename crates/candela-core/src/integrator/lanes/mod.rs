@@ -74,6 +74,15 @@ struct BounceLanes {
 }
 
 impl BounceLanes {
+    /// Forgets the last bounce: only the flags need it (the values are written for the
+    /// lanes the flags select).
+    #[inline(always)]
+    fn clear(&mut self) {
+        self.shaded = [false; LANES];
+        self.diffuse = [false; LANES];
+        self.roulette = [false; LANES];
+    }
+
     fn new() -> BounceLanes {
         BounceLanes {
             shaded: [false; LANES],
@@ -107,36 +116,32 @@ pub(super) fn render_lanes<S: Sampler, K: SampleSink, const V3: bool>(
     sink: &mut K,
 ) -> RenderStats {
     let Band { rows, width, pass } = band;
-    let spp = pass.len();
-    let total = rows.len() * width as usize * spp;
-    // Pixel sample `k` of the band: pixel-major, as `render_pixels` takes them.
-    let sample_at = |k: usize| {
-        let pixel = (k / spp) as u32;
-        let p = UVec2::new(pixel % width, rows.start + pixel / width);
-        (p, pass.start + (k % spp) as u32)
-    };
-    let mut results = vec![(Vec2::ZERO, Vec3::ZERO); total];
+    let total = rows.len() * width as usize * pass.len();
+    // The band's pixel samples, pixel-major as `render_pixels` takes them, numbered.
+    let mut pending = rows
+        .flat_map(|y| (0..width).map(move |x| UVec2::new(x, y)))
+        .flat_map(|p| pass.clone().map(move |index| (p, index)))
+        .enumerate();
+    let mut results = vec![(UVec2::ZERO, Vec2::ZERO, Vec3::ZERO); total];
     let mut stats = RenderStats {
         paths: total as u64,
         rays: 0,
     };
     let mut lanes = PathLanes::new(sampler);
-    let mut next = 0;
     let mut refill = |lanes: &mut PathLanes<S>, i: usize| {
-        if next == total {
+        let Some((slot, (p, index))) = pending.next() else {
             lanes.slot[i] = None;
             return;
-        }
-        let (p, index) = sample_at(next);
+        };
         let (film_pos, ray) = camera_ray(scene, &mut lanes.samplers[i], p, index, K::SPLATS);
-        lanes.start(i, next, film_pos, ray);
-        next += 1;
+        lanes.start(i, slot, p, film_pos, ray);
     };
     for i in 0..LANES {
         refill(&mut lanes, i);
     }
+    let mut b = BounceLanes::new();
     while lanes.slot.iter().any(Option::is_some) {
-        let mut b = BounceLanes::new();
+        b.clear();
         for i in 0..LANES {
             if lanes.slot[i].is_some() {
                 b.shaded[i] = shade_lane::<S, V3>(scene, &mut lanes, &mut b, i, &mut stats.rays);
@@ -158,13 +163,13 @@ pub(super) fn render_lanes<S: Sampler, K: SampleSink, const V3: bool>(
                 lanes.prev[i].bsdf_pdf = b.pdf[i];
                 lanes.depth[i] += 1;
             } else {
-                results[slot] = (lanes.film_pos[i], lanes.l[i]);
+                results[slot] = (lanes.pixel[i], lanes.film_pos[i], lanes.l[i]);
                 refill(&mut lanes, i);
             }
         }
     }
-    for (k, &(film_pos, l)) in results.iter().enumerate() {
-        sink.add(sample_at(k).0, film_pos, l);
+    for &(p, film_pos, l) in &results {
+        sink.add(p, film_pos, l);
     }
     stats
 }
@@ -194,14 +199,14 @@ fn shade_lane<S: Sampler, const V3: bool>(
     if hides_emitter(scene, depth, hit) {
         return false;
     }
-    let (specular, prev, beta) = (lanes.specular[i], lanes.prev[i], lanes.beta.lane(i));
+    let (specular, prev, beta) = (lanes.specular[i], &lanes.prev[i], lanes.beta.lane(i));
     let l = &mut lanes.l[i];
     let Some(si) = hit else {
-        add_escaped(scene, &ray, depth, specular, &prev, beta, l);
+        add_escaped(scene, &ray, depth, specular, prev, beta, l);
         return false;
     };
     let wo = -ray.d;
-    add_emitted(scene, si, &ray, specular, &prev, beta, l);
+    add_emitted(scene, si, &ray, specular, prev, beta, l);
     let Some(u) = u else {
         return false;
     };
@@ -212,6 +217,8 @@ fn shade_lane<S: Sampler, const V3: bool>(
     let sampled = match bsdf.lobe {
         Lobe::Diffuse(d) => {
             b.diffuse[i] = true;
+            b.delta[i] = false;
+            b.eta_crossed_sq[i] = 1.0;
             b.lambert.ng.set_lane(i, bsdf.ng);
             b.lambert.wo.set_lane(i, wo);
             b.lambert.albedo.set_lane(i, d.albedo);

@@ -3,7 +3,7 @@
 //! reads (rays, hits, radiance, previous vertex) as arrays of records, and each lane's
 //! sampler and pixel sample.
 
-use glam::{Vec2, Vec3};
+use glam::{UVec2, Vec2, Vec3};
 
 use super::simd::{Lanes32, Vec3Lanes, LANES};
 use crate::geometry::Ray;
@@ -18,8 +18,9 @@ pub(super) struct PathLanes<S> {
     /// Each lane's sample stream, positioned in its current pixel sample.
     pub samplers: [S; LANES],
     /// The pixel sample a lane follows: its index among the band's samples (pixel-major,
-    /// then sample index), and its film position.
+    /// then sample index), its pixel and its film position.
     pub slot: [Option<usize>; LANES],
+    pub pixel: [UVec2; LANES],
     pub film_pos: [Vec2; LANES],
     /// The ray to trace next.
     pub ray: [Ray; LANES],
@@ -46,6 +47,7 @@ impl<S: Clone> PathLanes<S> {
         PathLanes {
             samplers: std::array::from_fn(|_| sampler.clone()),
             slot: [None; LANES],
+            pixel: [UVec2::ZERO; LANES],
             film_pos: [Vec2::ZERO; LANES],
             ray: [ray; LANES],
             hit: [None; LANES],
@@ -64,11 +66,13 @@ impl<S: Clone> PathLanes<S> {
         }
     }
 
-    /// Starts lane `i` on pixel sample `slot`, whose camera ray through `film_pos` is
-    /// `ray` (its sampler already positioned there): the state a path starts with.
+    /// Starts lane `i` on pixel sample `slot`, of pixel `pixel`, whose camera ray through
+    /// `film_pos` is `ray` (its sampler already positioned there): the state a path starts
+    /// with.
     #[inline(always)]
-    pub fn start(&mut self, i: usize, slot: usize, film_pos: Vec2, ray: Ray) {
+    pub fn start(&mut self, i: usize, slot: usize, pixel: UVec2, film_pos: Vec2, ray: Ray) {
         self.slot[i] = Some(slot);
+        self.pixel[i] = pixel;
         self.film_pos[i] = film_pos;
         self.ray[i] = ray;
         self.l[i] = Vec3::ZERO;
