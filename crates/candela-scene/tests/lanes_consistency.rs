@@ -214,3 +214,25 @@ fn the_welch_test_rejects_a_five_percent_bias() {
         failed.len()
     );
 }
+
+#[test]
+fn the_integrator_key_loads_and_defaults_to_path() {
+    let parse = |text: &str| {
+        candela_scene::parse_toml_scene(text, Path::new("scene.toml")).map_err(|e| e.to_string())
+    };
+    assert_eq!(
+        parse("[render]\n").unwrap().render.integrator,
+        IntegratorKind::Path
+    );
+    for (name, kind) in [
+        ("path", IntegratorKind::Path),
+        ("lanes", IntegratorKind::Lanes),
+    ] {
+        let desc = parse(&format!("[render]\nintegrator = \"{name}\"\n")).unwrap();
+        assert_eq!(desc.render.integrator, kind, "{name}");
+    }
+    assert_eq!(
+        parse("[render]\nintegrator = \"lane\"\n").unwrap_err(),
+        "scene.toml:2:14: unknown variant `lane`, expected `path` or `lanes`"
+    );
+}
