@@ -4,7 +4,8 @@
 //!
 //! It estimates what the path integrator ([`super::path`]) does, with the same numbers: each
 //! lane has its own sampler, positioned at its pixel sample as the path integrator's is,
-//! and draws the same dimensions in the same order. Each bounce runs in two stages:
+//! and draws the same dimensions in the same order (all lanes' at once where the sampler
+//! can: [`Sampler::draw_bounce_lanes`]). Each bounce runs in two stages:
 //! - per lane, scalar (`shade_lane`): the bounce's numbers, the closest hit, emission
 //!   found, the BSDF at the hit, next event estimation, and the direction of every lobe
 //!   but the Lambertian one;
@@ -38,7 +39,7 @@ use super::RenderStats;
 use crate::bsdf::Lobe;
 use crate::light::ShadingCtx;
 use crate::options::IntegratorKind;
-use crate::sampler::Sampler;
+use crate::sampler::{BounceDraws, Sampler};
 use crate::scene::Scene;
 
 /// Why the lanes integrator, where a scene asks for it, does not render it: `None` where
@@ -142,9 +143,15 @@ pub(super) fn render_lanes<S: Sampler, K: SampleSink, const V3: bool>(
     let mut b = BounceLanes::new();
     while lanes.slot.iter().any(Option::is_some) {
         b.clear();
+        // The bounce's numbers of all lanes at once where the sampler can (the independent
+        // sampler in the v3 copy); idle lanes and lanes whose path ends here draw too,
+        // which changes nothing: a lane's stream restarts with its next pixel sample.
+        let drawn = S::draw_bounce_lanes(&mut lanes.samplers, V3);
         for i in 0..LANES {
             if lanes.slot[i].is_some() {
-                b.shaded[i] = shade_lane::<S, V3>(scene, &mut lanes, &mut b, i, &mut stats.rays);
+                let drawn = drawn.as_ref();
+                b.shaded[i] =
+                    shade_lane::<S, V3>(scene, &mut lanes, &mut b, drawn, i, &mut stats.rays);
             }
         }
         let alive = match V3 {
@@ -178,11 +185,14 @@ pub(super) fn render_lanes<S: Sampler, K: SampleSink, const V3: bool>(
 /// throughput update: draws the bounce's numbers, traces the lane's ray, adds the emission
 /// found and next event estimation to its radiance, and leaves in `b` what the lane stage
 /// needs to continue the path. Returns whether the path scatters here (else it ends).
+/// `drawn`: the bounce's numbers of every lane, where the sampler drew them at once; else
+/// the lane draws its own.
 #[inline(always)]
 fn shade_lane<S: Sampler, const V3: bool>(
     scene: &Scene,
     lanes: &mut PathLanes<S>,
     b: &mut BounceLanes,
+    drawn: Option<&BounceDraws<S::Deferred1d>>,
     i: usize,
     rays: &mut u64,
 ) -> bool {
@@ -191,7 +201,20 @@ fn shade_lane<S: Sampler, const V3: bool>(
     let sampler = &mut lanes.samplers[i];
     let u = (depth < scene.settings.max_depth).then(
         #[inline(always)]
-        || BounceSamples::<S>::draw(scene, sampler),
+        || match drawn {
+            // As `BounceSamples::draw`: the light pick is 0.5 where there is one light.
+            Some(d) => BounceSamples {
+                light: if scene.lights.len() > 1 {
+                    d.light[i]
+                } else {
+                    0.5
+                },
+                point: Vec2::new(d.point[0][i], d.point[1][i]),
+                lobe: d.lobe[i],
+                dir: Vec2::new(d.dir[0][i], d.dir[1][i]),
+            },
+            None => BounceSamples::<S>::draw(scene, sampler),
+        },
     );
     let ray = lanes.ray[i];
     lanes.hit[i] = scene.intersect(&ray, f32::INFINITY);
@@ -259,10 +282,15 @@ fn shade_lane<S: Sampler, const V3: bool>(
     }
     lanes.prev[i].ctx = ctx;
     if depth + 1 < scene.settings.rr_depth {
-        sampler.skip_1d();
+        if drawn.is_none() {
+            sampler.skip_1d();
+        }
     } else {
         b.roulette[i] = true;
-        b.u_rr[i] = sampler.get_1d();
+        b.u_rr[i] = match drawn {
+            Some(d) => d.roulette[i],
+            None => sampler.get_1d(),
+        };
     }
     true
 }
