@@ -12,7 +12,8 @@ use std::time::Instant;
 
 use candela_core::desc::{
     AccelStorage, ApertureSizeDesc, EnvironmentDesc, EnvironmentMapDesc, FilterSampling, FocusDesc,
-    Isa, LampSampling, LensDesc, LightSamplerKind, MisMode, SamplerKind, SceneDesc, Span,
+    IntegratorKind, Isa, LampSampling, LensDesc, LightSamplerKind, MisMode, SamplerKind, SceneDesc,
+    Span,
 };
 use candela_core::integrator;
 use clap::Args;
@@ -106,6 +107,10 @@ pub struct RenderArgs {
     /// sampling only) or bsdf (BSDF sampling only).
     #[arg(long, value_parser = parse_name::<MisMode>)]
     mis: Option<MisMode>,
+    /// Which integrator follows the paths: path (the default: one path at a time) or
+    /// lanes (eight paths at a time in SIMD lanes; scenes with media fall back to path).
+    #[arg(long, value_parser = parse_name::<IntegratorKind>)]
+    integrator: Option<IntegratorKind>,
     /// How next event estimation picks a light: uniform, power, array, ris, bvh (the
     /// default) or ris-bvh.
     #[arg(long, value_parser = parse_name::<LightSamplerKind>)]
@@ -218,6 +223,7 @@ impl RenderArgs {
             (r.width, r.height) = (w, h);
         }
         r.mis = self.mis.unwrap_or(r.mis);
+        r.integrator = self.integrator.unwrap_or(r.integrator);
         r.light_sampler = self.light_sampler.unwrap_or(r.light_sampler);
         r.lamp_sampling = self.lamp_sampling.unwrap_or(r.lamp_sampling);
         if let Some(n) = self.ris_candidates {
@@ -357,6 +363,9 @@ pub fn run(args: RenderArgs) -> Result<ExitCode, UserError> {
     let build_s = built.elapsed().as_secs_f64();
     let build_peak = crate::footprint::peak_resident_bytes();
     let s = &scene.settings;
+    if let Some(why) = integrator::lanes_fallback(&scene) {
+        eprintln!("candela: --integrator lanes: {why}; rendering with the path integrator");
+    }
 
     let threads = args.threads.unwrap_or(0);
     let pool = rayon::ThreadPoolBuilder::new()

@@ -323,3 +323,43 @@ fn lamp_sampling_flag_and_key_reach_the_lamps() {
     assert!(err.contains("solid-angle"), "{err}");
     assert!(!out.exists());
 }
+
+/// `--integrator lanes` renders the path integrator's image (bit for bit: see
+/// candela-scene's lanes_consistency) and says once why a scene with media falls back.
+#[test]
+fn the_lanes_integrator_renders_the_same_file_and_names_its_fallback() {
+    let (dir, scene) = scene_dir(SCENE);
+    let render = |integrator: &str, scene: &str, out: &str| {
+        let out = dir.path().join(out);
+        let o = candela(&["render", scene, "-o", s(&out), "--integrator", integrator]);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        (
+            std::fs::read(&out).unwrap(),
+            String::from_utf8_lossy(&o.stderr).into_owned(),
+        )
+    };
+    let (path, _) = render("path", s(&scene), "path.pfm");
+    let (lanes, quiet) = render("lanes", s(&scene), "lanes.pfm");
+    assert!(path == lanes, "the lanes integrator wrote another image");
+    assert!(!quiet.contains("--integrator lanes"), "{quiet}");
+    let media = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../scenes/media.toml");
+    let o = candela(&[
+        "render",
+        s(&media),
+        "-o",
+        s(&dir.path().join("media.pfm")),
+        "--integrator",
+        "lanes",
+        "--res",
+        "16x12",
+        "--spp",
+        "1",
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(
+        stderr.matches("participating media").count(),
+        1,
+        "one fallback line: {stderr}"
+    );
+}

@@ -27,7 +27,8 @@ mod media;
 pub mod photometry;
 
 pub use crate::options::{
-    AccelStorage, FilterSampling, Isa, LampSampling, LightSamplerKind, MisMode, SamplerKind,
+    AccelStorage, FilterSampling, IntegratorKind, Isa, LampSampling, LightSamplerKind, MisMode,
+    SamplerKind,
 };
 pub use conductors::{conductor, metal_preset, CONDUCTORS, METAL_PRESETS};
 pub use media::*;
@@ -616,6 +617,8 @@ pub struct RenderSettings {
     pub rr_depth: u32,
     pub seed: u64,
     pub mis: MisMode,
+    /// Which integrator follows the paths (see [`IntegratorKind`]).
+    pub integrator: IntegratorKind,
     pub light_sampler: LightSamplerKind,
     /// How next event estimation draws points on flat lamps.
     pub lamp_sampling: LampSampling,
@@ -663,6 +666,7 @@ impl Default for RenderSettings {
             rr_depth: DEFAULT_RR_DEPTH,
             seed: 0,
             mis: MisMode::default(),
+            integrator: IntegratorKind::default(),
             light_sampler: LightSamplerKind::default(),
             lamp_sampling: LampSampling::default(),
             ris_candidates: DEFAULT_RIS_CANDIDATES,

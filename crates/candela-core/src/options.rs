@@ -26,6 +26,23 @@ pub enum MisMode {
     BsdfOnly,
 }
 
+/// Which integrator follows the camera paths of a scene without media. Its names in scene
+/// files and on the command line are `path` and `lanes`. Both estimate the same image
+/// (the per-tile Welch tests of `crates/candela-scene/tests/lanes_consistency.rs`); scenes
+/// with media use the volumetric path tracer whichever is chosen.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum IntegratorKind {
+    /// One path at a time ([`crate::integrator::li`]): the default, since the lanes
+    /// integrator takes more instructions per path on every bench scene
+    /// (bench/RESULTS.md, lanes_integrator).
+    #[default]
+    Path,
+    /// Eight paths at a time in SIMD lanes, each lane refilled with the band's next pixel
+    /// sample when its path ends (see `crate::integrator::lanes`).
+    Lanes,
+}
+
 /// How to pick the one light that next event estimation samples. Its names in scene files
 /// and on the command line are the variants' names in kebab case (`ris-bvh`).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Deserialize)]
@@ -245,6 +262,7 @@ pub struct RenderOptions {
     pub rr_depth: u32,
     pub seed: u64,
     pub mis: MisMode,
+    pub integrator: IntegratorKind,
     pub sampler: SamplerKind,
     /// Camera rays that hit an emitter or escape return nothing.
     pub hide_emitters: bool,

@@ -295,6 +295,7 @@ fn render_options(r: &RenderSettings) -> RenderOptions {
         rr_depth: r.rr_depth,
         seed: r.seed,
         mis: r.mis,
+        integrator: r.integrator,
         sampler: r.sampler,
         hide_emitters: r.hide_emitters,
         filter_sampling: r.filter_sampling,

@@ -7,7 +7,9 @@ use glam::Vec3;
 
 use super::band::{render_pixels, Band, SampleSink};
 use super::direct::{sample_direct, NeeVertex};
+use super::lanes::render_lanes;
 use super::RenderStats;
+use crate::options::{IntegratorKind, Isa};
 use crate::sampler::Sampler;
 use crate::scene::Scene;
 
@@ -35,7 +37,21 @@ v3_fn! {
     }
 }
 
-/// Takes a work item's samples with the render loop's copy `isa`, which the CPU must run.
+v3_fn! {
+    /// [`render_lanes`] compiled for x86-64-v3.
+    fn render_lanes_v3<S: Sampler, K: SampleSink>(
+        scene: &Scene,
+        sampler: &mut S,
+        band: Band,
+        sink: &mut K,
+    ) -> RenderStats {
+        render_lanes::<S, K, true>(scene, sampler, band, sink)
+    }
+}
+
+/// Takes a work item's samples with the render loop's copy `isa`, which the CPU must run,
+/// and the integrator the scene asks for (the path integrator where the lanes integrator
+/// does not cover the scene: see [`super::lanes_fallback`]).
 pub(crate) fn render_band<S: Sampler, K: SampleSink>(
     scene: &Scene,
     isa: crate::options::Isa,
@@ -44,11 +60,15 @@ pub(crate) fn render_band<S: Sampler, K: SampleSink>(
     sink: &mut K,
 ) -> RenderStats {
     debug_assert!(isa.is_supported());
-    match isa {
-        // SAFETY: `render_with` asserted that the CPU has the resolved ISA.
+    let lanes = scene.settings.integrator == IntegratorKind::Lanes && scene.media.is_none();
+    match (isa, lanes) {
+        // SAFETY (both v3 arms): `render_with` asserted that the CPU has the resolved ISA.
         #[cfg(target_arch = "x86_64")]
-        crate::options::Isa::V3 => unsafe { render_pixels_v3(scene, sampler, band, sink) },
-        _ => render_pixels::<S, K, false>(scene, sampler, band, sink),
+        (Isa::V3, false) => unsafe { render_pixels_v3(scene, sampler, band, sink) },
+        #[cfg(target_arch = "x86_64")]
+        (Isa::V3, true) => unsafe { render_lanes_v3(scene, sampler, band, sink) },
+        (_, false) => render_pixels::<S, K, false>(scene, sampler, band, sink),
+        (_, true) => render_lanes::<S, K, false>(scene, sampler, band, sink),
     }
 }
 

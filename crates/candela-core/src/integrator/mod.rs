@@ -10,6 +10,8 @@
 //!   dispatch between them;
 //! - `band`: one work item's pixel samples, each its camera ray and its path;
 //! - `path`: the path loop ([`li`]) for scenes without media;
+//! - `lanes`: the lanes integrator, eight paths at a time in SIMD lanes, for scenes
+//!   without media that ask for it ([`crate::options::IntegratorKind::Lanes`]);
 //! - `direct`: next event estimation and its MIS weight;
 //! - `volpath`: the volumetric path tracer, for scenes with media.
 
@@ -24,6 +26,7 @@ use crate::scene::Scene;
 mod band;
 mod copies;
 mod direct;
+mod lanes;
 mod path;
 mod schedule;
 mod sky;
@@ -31,6 +34,7 @@ mod volpath;
 
 pub(crate) use band::{camera_ray, Band, SampleSink};
 pub(crate) use copies::render_band;
+pub use lanes::lanes_fallback;
 pub use path::li;
 pub use schedule::render_with;
 pub(crate) use schedule::PassCtx;

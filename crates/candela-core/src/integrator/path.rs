@@ -14,7 +14,7 @@ use crate::light::{LightId, ShadingCtx};
 use crate::math::max_component;
 use crate::options::MisMode;
 use crate::sampler::Sampler;
-use crate::scene::Scene;
+use crate::scene::{Scene, SurfaceInteraction};
 
 /// Radiance arriving along `ray`, estimated by one path.
 #[inline(always)]
@@ -33,7 +33,6 @@ pub(super) fn li_isa<S: Sampler, const V3: bool>(
     if let Some(media) = scene.media.as_deref() {
         return volpath::li(scene, media, ray, sampler, rays);
     }
-    let mode = scene.settings.mis;
     let mut l = Vec3::ZERO;
     let mut beta = Vec3::ONE;
     // The product of η′² over the refractions so far (see `Bsdf::eta_crossed_sq`).
@@ -42,26 +41,12 @@ pub(super) fn li_isa<S: Sampler, const V3: bool>(
     // Whether the path's last bounce was a delta lobe (or the path just left the camera):
     // then no light sampling could have found what the ray hits, so it counts in full.
     let mut specular = true;
-    let mut prev_ctx = ShadingCtx {
-        p: ray.o,
-        n: Vec3::ZERO,
-    };
-    let mut prev_bsdf_pdf = 0.0f32;
-
-    // Weight of emission found by BSDF sampling, against NEE having found it.
-    let emitter_weight = |specular: bool,
-                          prev_ctx: &ShadingCtx,
-                          prev_bsdf_pdf: f32,
-                          id: LightId,
-                          d: Vec3| match mode {
-        _ if specular => 1.0,
-        MisMode::BsdfOnly => 1.0,
-        MisMode::NeeOnly => 0.0,
-        MisMode::Balance | MisMode::Power => {
-            let light_pdf =
-                scene.light_sampler.pmf(prev_ctx, id) * scene.light(id).pdf_li(prev_ctx, d);
-            mis_weight(mode, prev_bsdf_pdf, light_pdf)
-        }
+    let mut prev = PrevVertex {
+        ctx: ShadingCtx {
+            p: ray.o,
+            n: Vec3::ZERO,
+        },
+        bsdf_pdf: 0.0,
     };
 
     loop {
@@ -75,39 +60,15 @@ pub(super) fn li_isa<S: Sampler, const V3: bool>(
             || BounceSamples::<S>::draw(scene, sampler),
         );
         let hit = scene.intersect(&ray, f32::INFINITY);
-        if depth == 0
-            && scene.settings.hide_emitters
-            && hit.as_ref().is_none_or(|si| si.light.is_some())
-        {
+        if hides_emitter(scene, depth, hit.as_ref()) {
             break;
         }
         let Some(si) = hit.as_ref() else {
-            for &id in &scene.infinite_lights {
-                let light = scene.light(id);
-                let (le, weight) = if depth == 0 {
-                    (light.le_camera(&ray), 1.0)
-                } else if !specular && matches!(mode, MisMode::Balance | MisMode::Power) {
-                    // The radiance and the density MIS weighs it by, from one lookup.
-                    let (le, pdf) = light.le_pdf(&prev_ctx, &ray);
-                    let light_pdf = scene.light_sampler.pmf(&prev_ctx, id) * pdf;
-                    (le, mis_weight(mode, prev_bsdf_pdf, light_pdf))
-                } else {
-                    let weight = emitter_weight(specular, &prev_ctx, prev_bsdf_pdf, id, ray.d);
-                    (light.le(&ray), weight)
-                };
-                if le != Vec3::ZERO {
-                    l += beta * le * weight;
-                }
-            }
+            add_escaped(scene, &ray, depth, specular, &prev, beta, &mut l);
             break;
         };
         let wo = -ray.d;
-        if let Some(id) = si.light {
-            let le = scene.light(id).radiance(si.ng, si.uv, wo);
-            if le != Vec3::ZERO {
-                l += beta * le * emitter_weight(specular, &prev_ctx, prev_bsdf_pdf, id, ray.d);
-            }
-        }
+        add_emitted(scene, si, &ray, specular, &prev, beta, &mut l);
         let Some(u) = u else {
             break;
         };
@@ -131,22 +92,17 @@ pub(super) fn li_isa<S: Sampler, const V3: bool>(
                 u_light: u.light,
                 u_point: u.point,
             };
-            l += beta
-                * match V3 {
-                    // SAFETY: only the v3 copy of the render loop has `V3`, and `render_with`
-                    // asserted that the CPU runs it.
-                    #[cfg(target_arch = "x86_64")]
-                    true => unsafe { sample_direct_v3(scene, &v, rays) },
-                    _ => sample_direct_baseline(scene, &v, rays),
-                };
+            l += beta * direct::<V3>(scene, &v, rays);
         }
         let Some(bs) = bs else {
             break;
         };
         beta *= bs.f * (bsdf.abs_cos(bs.wi) / bs.pdf);
         specular = bs.flags.is_delta();
-        prev_bsdf_pdf = bs.pdf;
-        prev_ctx = ctx;
+        prev = PrevVertex {
+            ctx,
+            bsdf_pdf: bs.pdf,
+        };
         ray = si.spawn_ray(bs.wi);
         depth += 1;
 
@@ -171,22 +127,117 @@ pub(super) fn li_isa<S: Sampler, const V3: bool>(
     l
 }
 
+/// What emission found by BSDF sampling is weighed against: where the path left its last
+/// scattering vertex, and the density of the BSDF sample that left it.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct PrevVertex {
+    pub ctx: ShadingCtx,
+    pub bsdf_pdf: f32,
+}
+
+/// Whether a camera ray's hit (or miss, `None`) returns nothing because the scene hides
+/// emitters seen directly.
+#[inline(always)]
+pub(super) fn hides_emitter(scene: &Scene, depth: u32, hit: Option<&SurfaceInteraction>) -> bool {
+    depth == 0 && scene.settings.hide_emitters && hit.is_none_or(|si| si.light.is_some())
+}
+
+/// Weight of emission found by BSDF sampling, against NEE having found it.
+#[inline(always)]
+fn emitter_weight(scene: &Scene, specular: bool, prev: &PrevVertex, id: LightId, d: Vec3) -> f32 {
+    let mode = scene.settings.mis;
+    match mode {
+        _ if specular => 1.0,
+        MisMode::BsdfOnly => 1.0,
+        MisMode::NeeOnly => 0.0,
+        MisMode::Balance | MisMode::Power => {
+            let light_pdf =
+                scene.light_sampler.pmf(&prev.ctx, id) * scene.light(id).pdf_li(&prev.ctx, d);
+            mis_weight(mode, prev.bsdf_pdf, light_pdf)
+        }
+    }
+}
+
+/// Adds to `l` the light of the infinite lights that `ray`, which escaped, sees, weighed
+/// by the path throughput `beta` and by MIS against NEE at the previous vertex.
+#[inline(always)]
+pub(super) fn add_escaped(
+    scene: &Scene,
+    ray: &Ray,
+    depth: u32,
+    specular: bool,
+    prev: &PrevVertex,
+    beta: Vec3,
+    l: &mut Vec3,
+) {
+    let mode = scene.settings.mis;
+    for &id in &scene.infinite_lights {
+        let light = scene.light(id);
+        let (le, weight) = if depth == 0 {
+            (light.le_camera(ray), 1.0)
+        } else if !specular && matches!(mode, MisMode::Balance | MisMode::Power) {
+            // The radiance and the density MIS weighs it by, from one lookup.
+            let (le, pdf) = light.le_pdf(&prev.ctx, ray);
+            let light_pdf = scene.light_sampler.pmf(&prev.ctx, id) * pdf;
+            (le, mis_weight(mode, prev.bsdf_pdf, light_pdf))
+        } else {
+            let weight = emitter_weight(scene, specular, prev, id, ray.d);
+            (light.le(ray), weight)
+        };
+        if le != Vec3::ZERO {
+            *l += beta * le * weight;
+        }
+    }
+}
+
+/// Adds to `l` the emission of the surface `ray` hit at `si` (if it is a light), weighed
+/// as in [`add_escaped`].
+#[inline(always)]
+pub(super) fn add_emitted(
+    scene: &Scene,
+    si: &SurfaceInteraction,
+    ray: &Ray,
+    specular: bool,
+    prev: &PrevVertex,
+    beta: Vec3,
+    l: &mut Vec3,
+) {
+    if let Some(id) = si.light {
+        let le = scene.light(id).radiance(si.ng, si.uv, -ray.d);
+        if le != Vec3::ZERO {
+            *l += beta * le * emitter_weight(scene, specular, prev, id, ray.d);
+        }
+    }
+}
+
+/// Next event estimation at `v` in the copy of the render loop `V3` says.
+#[inline(always)]
+pub(super) fn direct<const V3: bool>(scene: &Scene, v: &NeeVertex, rays: &mut u64) -> Vec3 {
+    match V3 {
+        // SAFETY: only the v3 copy of the render loop has `V3`, and `render_with` asserted
+        // that the CPU runs it.
+        #[cfg(target_arch = "x86_64")]
+        true => unsafe { sample_direct_v3(scene, v, rays) },
+        _ => sample_direct_baseline(scene, v, rays),
+    }
+}
+
 /// The numbers one bounce takes, in the order of their dimensions.
-struct BounceSamples<S: Sampler> {
+pub(super) struct BounceSamples<S: Sampler> {
     /// The light pick (0.5, its dimension skipped, where there is one light).
-    light: f32,
+    pub light: f32,
     /// The point on the light.
-    point: Vec2,
+    pub point: Vec2,
     /// The BSDF's lobe choice, deferred: the hit is not known yet, and most BSDFs (one
     /// lobe) do not read it.
-    lobe: S::Deferred1d,
+    pub lobe: S::Deferred1d,
     /// The BSDF direction.
-    dir: Vec2,
+    pub dir: Vec2,
 }
 
 impl<S: Sampler> BounceSamples<S> {
     #[inline(always)]
-    fn draw(scene: &Scene, sampler: &mut S) -> BounceSamples<S> {
+    pub(super) fn draw(scene: &Scene, sampler: &mut S) -> BounceSamples<S> {
         // A number nothing reads is skipped, not computed (its dimension stays taken).
         let light = if scene.lights.len() > 1 {
             sampler.get_1d()

@@ -16,8 +16,14 @@
 //! renderer does not offer it).
 //! The integrator picks one by [`crate::desc::SamplerKind`] and is monomorphized for each,
 //! so no call is dynamic.
+//!
+//! The lanes integrator may take a bounce's numbers for eight streams at once
+//! ([`Sampler::draw_bounce_lanes`]): the independent sampler does so in AVX2
+//! (`pcg_lanes`), the others one stream at a time.
 
 mod cmj;
+#[cfg(target_arch = "x86_64")]
+mod pcg_lanes;
 mod sobol;
 mod sobol_cmj;
 
@@ -26,6 +32,21 @@ use glam::{UVec2, Vec2};
 pub use cmj::CmjSampler;
 pub use sobol::{owen_scramble, sobol_2d, SobolSampler};
 pub use sobol_cmj::{first_direction_dimension, SobolCmjSampler};
+
+/// Streams a batched draw serves at once ([`Sampler::draw_bounce_lanes`]): the lanes
+/// integrator's paths in flight.
+pub const LANES: usize = 8;
+
+/// One bounce's numbers for [`LANES`] streams, in the order the integrator takes them
+/// (light pick, light point, BSDF lobe, BSDF direction, Russian roulette): entry `[i]` (or
+/// `[k][i]` for the two coordinates of a 2D request) is stream `i`'s.
+pub struct BounceDraws<D> {
+    pub light: [f32; LANES],
+    pub point: [[f32; LANES]; 2],
+    pub lobe: [D; LANES],
+    pub dir: [[f32; LANES]; 2],
+    pub roulette: [f32; LANES],
+}
 
 /// A source of uniform numbers in [0, 1) for one pixel sample at a time.
 pub trait Sampler: Send + Sync + Clone {
@@ -52,6 +73,18 @@ pub trait Sampler: Send + Sync + Clone {
     fn defer_1d(&mut self) -> Self::Deferred1d;
     /// The value of a request [`Self::defer_1d`] deferred in the current pixel sample.
     fn resolve_1d(&self, d: Self::Deferred1d) -> f32;
+    /// One bounce's requests (see [`BounceDraws`]) of each of `streams` at once, as
+    /// `get_1d`, `get_2d`, `defer_1d`, `get_2d`, `get_1d` would give them one stream at a
+    /// time (a request the caller would skip is drawn all the same: it takes its place
+    /// either way); `None`, with the streams untouched, where the sampler has no batched
+    /// draw. `avx2`: whether the caller runs where the CPU has AVX2.
+    fn draw_bounce_lanes(
+        streams: &mut [Self; LANES],
+        avx2: bool,
+    ) -> Option<BounceDraws<Self::Deferred1d>> {
+        let _ = (streams, avx2);
+        None
+    }
 }
 
 /// Independent uniform random numbers from PCG32 (O'Neill 2014), one stream per pixel
@@ -102,6 +135,25 @@ impl Sampler for IndependentSampler {
 
     fn resolve_1d(&self, u: f32) -> f32 {
         u
+    }
+
+    /// PCG32 for the eight streams at once in AVX2 (`pcg_lanes`); none without AVX2.
+    fn draw_bounce_lanes(streams: &mut [Self; LANES], avx2: bool) -> Option<BounceDraws<f32>> {
+        #[cfg(target_arch = "x86_64")]
+        if avx2 {
+            // SAFETY: `avx2` says the CPU has AVX2.
+            let [light, px, py, lobe, dx, dy, roulette] =
+                unsafe { pcg_lanes::uniform_lanes::<7>(streams) };
+            return Some(BounceDraws {
+                light,
+                point: [px, py],
+                lobe,
+                dir: [dx, dy],
+                roulette,
+            });
+        }
+        let _ = (streams, avx2);
+        None
     }
 }
 

@@ -20,8 +20,9 @@ mod values;
 use std::path::Path;
 
 use candela_core::desc::{
-    AccelStorage, BsdfDesc, EmissionProfileDesc, FilterSampling, LampSampling, LightSamplerKind,
-    MaterialDesc, MisMode, RenderSettings, SamplerKind, SceneDesc, ShapeMediaDesc,
+    AccelStorage, BsdfDesc, EmissionProfileDesc, FilterSampling, IntegratorKind, LampSampling,
+    LightSamplerKind, MaterialDesc, MisMode, RenderSettings, SamplerKind, SceneDesc,
+    ShapeMediaDesc,
 };
 use serde::de::DeserializeOwned;
 use serde::Deserialize;
@@ -209,6 +210,7 @@ struct RenderSection {
     rr_depth: Option<u32>,
     seed: Option<u64>,
     mis: Option<MisMode>,
+    integrator: Option<IntegratorKind>,
     light_sampler: Option<LightSamplerKind>,
     lamp_sampling: Option<LampSampling>,
     ris_candidates: Option<std::num::NonZeroU32>,
@@ -231,6 +233,7 @@ fn parse_render(src: &Source, value: Item) -> Result<RenderSettings, LoadError> 
     out.rr_depth = r.rr_depth.unwrap_or(out.rr_depth);
     out.seed = r.seed.unwrap_or(out.seed);
     out.mis = r.mis.unwrap_or(out.mis);
+    out.integrator = r.integrator.unwrap_or(out.integrator);
     out.light_sampler = r.light_sampler.unwrap_or(out.light_sampler);
     out.lamp_sampling = r.lamp_sampling.unwrap_or(out.lamp_sampling);
     if let Some(n) = r.ris_candidates {
