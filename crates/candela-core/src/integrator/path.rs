@@ -9,6 +9,7 @@ use super::copies::sample_direct_baseline;
 use super::copies::sample_direct_v3;
 use super::direct::{mis_weight, NeeVertex};
 use super::volpath;
+use crate::bsdf::Bsdf;
 use crate::geometry::Ray;
 use crate::light::{LightId, ShadingCtx};
 use crate::math::max_component;
@@ -84,15 +85,7 @@ pub(super) fn li_isa<S: Sampler, const V3: bool>(
         };
         let bs = bsdf.sample(wo, u_lobe, u.dir);
         if !bsdf.is_delta() {
-            let v = NeeVertex {
-                si,
-                ctx: &ctx,
-                bsdf: &bsdf,
-                wo,
-                u_light: u.light,
-                u_point: u.point,
-            };
-            l += beta * direct::<V3>(scene, &v, rays);
+            l += beta * direct::<S, V3>(scene, si, &ctx, &bsdf, wo, &u, rays);
         }
         let Some(bs) = bs else {
             break;
@@ -210,15 +203,32 @@ pub(super) fn add_emitted(
     }
 }
 
-/// Next event estimation at `v` in the copy of the render loop `V3` says.
+/// Next event estimation at the hit `si` (shading context `ctx`, BSDF `bsdf`, towards
+/// `wo`) with the bounce's light numbers in `u`, in the copy of the render loop `V3` says.
 #[inline(always)]
-pub(super) fn direct<const V3: bool>(scene: &Scene, v: &NeeVertex, rays: &mut u64) -> Vec3 {
+pub(super) fn direct<S: Sampler, const V3: bool>(
+    scene: &Scene,
+    si: &SurfaceInteraction,
+    ctx: &ShadingCtx,
+    bsdf: &Bsdf,
+    wo: Vec3,
+    u: &BounceSamples<S>,
+    rays: &mut u64,
+) -> Vec3 {
+    let v = NeeVertex {
+        si,
+        ctx,
+        bsdf,
+        wo,
+        u_light: u.light,
+        u_point: u.point,
+    };
     match V3 {
         // SAFETY: only the v3 copy of the render loop has `V3`, and `render_with` asserted
         // that the CPU runs it.
         #[cfg(target_arch = "x86_64")]
-        true => unsafe { sample_direct_v3(scene, v, rays) },
-        _ => sample_direct_baseline(scene, v, rays),
+        true => unsafe { sample_direct_v3(scene, &v, rays) },
+        _ => sample_direct_baseline(scene, &v, rays),
     }
 }
 

@@ -33,7 +33,6 @@ use self::simd::Avx2;
 use self::simd::{F32x8, LaneIsa, Lanes32, M32x8, Portable, Vec3Lanes, Vec3x8, LANES};
 use self::state::PathLanes;
 use super::band::{camera_ray, Band, SampleSink};
-use super::direct::NeeVertex;
 use super::path::{add_emitted, add_escaped, direct, hides_emitter, BounceSamples};
 use super::RenderStats;
 use crate::bsdf::Lobe;
@@ -259,15 +258,7 @@ fn shade_lane<S: Sampler, const V3: bool>(
         }
     };
     if !bsdf.is_delta() {
-        let v = NeeVertex {
-            si,
-            ctx: &ctx,
-            bsdf: &bsdf,
-            wo,
-            u_light: u.light,
-            u_point: u.point,
-        };
-        *l += beta * direct::<V3>(scene, &v, rays);
+        *l += beta * direct::<S, V3>(scene, si, &ctx, &bsdf, wo, &u, rays);
     }
     match sampled {
         None => {}
