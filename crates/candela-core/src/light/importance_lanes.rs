@@ -87,17 +87,15 @@ impl ImportanceLanes {
     pub fn importance(&self, ctx: &ShadingCtx) -> [f32; LANES] {
         #[cfg(target_arch = "x86_64")]
         if std::arch::is_x86_feature_detected!("avx2") {
-            let mut out = [0.0f32; LANES];
             // SAFETY: the CPU has AVX2.
-            unsafe { _mm256_storeu_ps(out.as_mut_ptr(), self.importance_avx2(ctx)) };
-            return out;
+            return unsafe { self.importance_avx2(ctx) };
         }
         self.importance_scalar(ctx)
     }
 
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx,avx2")]
-    fn importance_avx2(&self, ctx: &ShadingCtx) -> __m256 {
+    fn importance_avx2(&self, ctx: &ShadingCtx) -> [f32; LANES] {
         // SAFETY (loads): every array is LANES f32 in a 32-byte aligned struct, at offsets
         // that are multiples of 32.
         let load = |a: &[f32; LANES]| unsafe { _mm256_load_ps(a.as_ptr()) };
@@ -160,7 +158,12 @@ impl ImportanceLanes {
             let sin_i = safe_sqrt(one_minus_sq(cos_i));
             importance = _mm256_mul_ps(importance, cos_sub(sin_i, cos_i, sin_b, cos_b));
         }
-        select(refused, zero, _mm256_max_ps(importance, zero))
+        let importance = select(refused, zero, _mm256_max_ps(importance, zero));
+        // Stored here, where the intrinsic inlines (outside AVX2 code it was a call).
+        let mut out = [0.0f32; LANES];
+        // SAFETY: `out` holds LANES f32.
+        unsafe { _mm256_storeu_ps(out.as_mut_ptr(), importance) };
+        out
     }
 }
 

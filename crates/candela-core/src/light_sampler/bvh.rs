@@ -53,6 +53,8 @@ struct Node {
 pub struct LightBvh {
     /// The tree's shape; the bounds are in `flat_lanes` or `descent`.
     nodes: Vec<TreeNode>,
+    /// See [`Self::tree_probability`].
+    p_tree: f32,
     infinite: Vec<u32>,
     /// Per infinite light, what weighs it at a point; empty where some infinite light
     /// has no such measure, or there are fewer than 2 or more than [`INFINITE_MAX`]
@@ -78,6 +80,16 @@ struct Item {
 }
 
 impl LightBvh {
+    /// The probability of picking the tree rather than one of `infinite` infinite lights
+    /// (1/(n + 1), the tree counting as one more light; 0 without a tree).
+    fn tree_probability(has_tree: bool, infinite: usize) -> f32 {
+        if has_tree {
+            1.0 / (infinite as f32 + 1.0)
+        } else {
+            0.0
+        }
+    }
+
     /// The tree over `lights`; `None` where no light emits.
     pub fn new(lights: &[Light]) -> Option<LightBvh> {
         let mut items = Vec::new();
@@ -109,6 +121,7 @@ impl LightBvh {
             Vec::new()
         };
         let mut bvh = LightBvh {
+            p_tree: Self::tree_probability(!items.is_empty(), infinite.len()),
             nodes: Vec::with_capacity(2 * items.len()),
             infinite,
             infinite_importance,
@@ -174,12 +187,9 @@ impl LightBvh {
     }
 
     /// Probability of picking the tree rather than an infinite light.
+    #[inline]
     fn p_tree(&self) -> f32 {
-        if self.nodes.is_empty() {
-            0.0
-        } else {
-            1.0 / (self.infinite.len() as f32 + 1.0)
-        }
+        self.p_tree
     }
 
     /// A light and its probability at `ctx`; `None` where no light in the tree can reach
@@ -239,7 +249,7 @@ impl LightBvh {
     /// and picks that follow each light rather than its cluster.
     fn sample_flat(&self, ctx: &ShadingCtx, u: f32) -> Option<(u32, f32)> {
         let (w, total) = self.flat_weights(ctx);
-        if total <= 0.0 || !total.is_finite() {
+        if !positive_finite(total) {
             return None;
         }
         let target = u * total;
@@ -260,7 +270,7 @@ impl LightBvh {
     /// Probability that [`Self::sample_flat`] picks `light` at `ctx`.
     fn flat_pmf(&self, ctx: &ShadingCtx, light: u32) -> f32 {
         let (w, total) = self.flat_weights(ctx);
-        if total <= 0.0 || !total.is_finite() {
+        if !positive_finite(total) {
             return 0.0;
         }
         self.flat
@@ -283,7 +293,7 @@ impl LightBvh {
             *w = m.at(ctx).max(0.0);
             total += *w;
         }
-        (total > 0.0 && total.is_finite()).then_some((w, total))
+        positive_finite(total).then_some((w, total))
     }
 
     /// One of the infinite lights (its index in `infinite`) and its probability among
@@ -330,6 +340,12 @@ impl LightBvh {
     pub fn node_count(&self) -> usize {
         self.nodes.len()
     }
+}
+
+/// Whether `x` is positive and finite (what a sum of weights must be to pick by it).
+#[inline(always)]
+fn positive_finite(x: f32) -> bool {
+    x > 0.0 && x < f32::INFINITY
 }
 
 /// SAOH cost of a cluster (pbrt-v4's `EvaluateCost`): intensity × orientation measure
