@@ -93,9 +93,16 @@ impl ImportanceLanes {
         self.importance_scalar(ctx)
     }
 
+    /// [`Self::importance`] in AVX2; inlined into AVX2 callers that evaluate several
+    /// lanes at one point (the light BVH's descent), which then splat the point once.
+    ///
+    /// # Safety
+    ///
+    /// The CPU must have AVX2.
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx,avx2")]
-    fn importance_avx2(&self, ctx: &ShadingCtx) -> [f32; LANES] {
+    #[inline]
+    pub fn importance_avx2(&self, ctx: &ShadingCtx) -> [f32; LANES] {
         // SAFETY (loads): every array is LANES f32 in a 32-byte aligned struct, at offsets
         // that are multiples of 32.
         let load = |a: &[f32; LANES]| unsafe { _mm256_load_ps(a.as_ptr()) };

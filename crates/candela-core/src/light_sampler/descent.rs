@@ -120,10 +120,34 @@ impl Descent {
     /// A light by descent from the root with `u ∈ [0, 1)`, and `pmf` times its
     /// probability; `None` where no light can reach the point.
     #[inline]
-    pub fn sample(&self, ctx: &ShadingCtx, mut u: f32, mut pmf: f32) -> Option<(u32, f32)> {
+    pub fn sample(&self, ctx: &ShadingCtx, u: f32, pmf: f32) -> Option<(u32, f32)> {
+        #[cfg(target_arch = "x86_64")]
+        if std::arch::is_x86_feature_detected!("avx2") {
+            // SAFETY: the CPU has AVX2.
+            return unsafe { self.sample_avx2(ctx, u, pmf) };
+        }
+        self.sample_by(|lanes| lanes.importance_scalar(ctx), u, pmf)
+    }
+
+    /// [`Self::sample`] in AVX2 code, the lanes' evaluation inlined (the point's splats
+    /// and the test of its normal then come once a descent rather than once a block).
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx,avx2")]
+    fn sample_avx2(&self, ctx: &ShadingCtx, u: f32, pmf: f32) -> Option<(u32, f32)> {
+        self.sample_by(|lanes| lanes.importance_avx2(ctx), u, pmf)
+    }
+
+    /// The descent of [`Self::sample`], each block's lanes weighed by `weigh`.
+    #[inline(always)]
+    fn sample_by(
+        &self,
+        weigh: impl Fn(&ImportanceLanes) -> [f32; 8],
+        mut u: f32,
+        mut pmf: f32,
+    ) -> Option<(u32, f32)> {
         let mut block = &self.blocks[0];
         loop {
-            let w = block.lanes.importance(ctx);
+            let w = weigh(&block.lanes);
             let first = choose(w[0], w[1], &mut u, &mut pmf)?;
             if let Some(light) = leaf(block.next[first]) {
                 return Some((light, pmf));
@@ -140,14 +164,37 @@ impl Descent {
     /// `pmf` times the probability that [`Self::sample`] reaches the leaf at the end of
     /// `trail` (bit d: the branch at level d, under a leading 1 that marks the depth).
     #[inline]
-    pub fn pmf(&self, ctx: &ShadingCtx, trail: u64, mut pmf: f32) -> f32 {
+    pub fn pmf(&self, ctx: &ShadingCtx, trail: u64, pmf: f32) -> f32 {
+        #[cfg(target_arch = "x86_64")]
+        if std::arch::is_x86_feature_detected!("avx2") {
+            // SAFETY: the CPU has AVX2.
+            return unsafe { self.pmf_avx2(ctx, trail, pmf) };
+        }
+        self.pmf_by(|lanes| lanes.importance_scalar(ctx), trail, pmf)
+    }
+
+    /// [`Self::pmf`] in AVX2 code, as [`Self::sample_avx2`].
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx,avx2")]
+    fn pmf_avx2(&self, ctx: &ShadingCtx, trail: u64, pmf: f32) -> f32 {
+        self.pmf_by(|lanes| lanes.importance_avx2(ctx), trail, pmf)
+    }
+
+    /// The retrace of [`Self::pmf`], each block's lanes weighed by `weigh`.
+    #[inline(always)]
+    fn pmf_by(
+        &self,
+        weigh: impl Fn(&ImportanceLanes) -> [f32; 8],
+        trail: u64,
+        mut pmf: f32,
+    ) -> f32 {
         let depth = 63 - trail.leading_zeros();
         let branch = |level: u32| ((trail >> level) & 1) as usize;
         let taken = |p: f32, branch: usize| if branch == 0 { p } else { 1.0 - p };
         let mut block = &self.blocks[0];
         let mut level = 0;
         loop {
-            let w = block.lanes.importance(ctx);
+            let w = weigh(&block.lanes);
             let first = branch(level);
             let Some(pa) = first_probability(w[0], w[1]) else {
                 return 0.0;
@@ -333,6 +380,9 @@ mod tests {
                 let got = descent.sample(&ctx, u, p0);
                 let bits = |s: Option<(u32, f32)>| s.map(|(i, p)| (i, p.to_bits()));
                 assert_eq!(bits(got), bits(want), "round {round}, point {k}");
+                // The fallback of CPUs without AVX2 too.
+                let scalar = descent.sample_by(|l| l.importance_scalar(&ctx), u, p0);
+                assert_eq!(bits(scalar), bits(want), "round {round}, point {k}");
                 match got {
                     Some((light, p)) => {
                         picks += 1;
