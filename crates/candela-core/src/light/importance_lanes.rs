@@ -1,7 +1,8 @@
 //! [`ImportanceBounds::importance`] of up to eight lights at once, in AVX2 lanes, with
 //! the same bits: for the light BVH's flat picks (at most `FLAT_MAX` lights, each weighed
-//! by its own bounds at every pick and every pmf), where the scalar form spent ~125
-//! instructions a light.
+//! by its own bounds at every pick and every pmf) and for its descent, two levels (a
+//! node's children and grandchildren) an evaluation, where the scalar form spent ~125
+//! instructions a node.
 //!
 //! The lanes repeat the scalar operations one for one, in the same order and without
 //! fused multiply-adds (the scalar code has none): IEEE `sqrt`, division, products and
@@ -19,7 +20,8 @@ use super::ShadingCtx;
 pub const LANES: usize = 8;
 
 /// Up to [`LANES`] [`ImportanceBounds`], one per lane, field by field (lanes past the
-/// lights repeat the first light; their results are to be ignored).
+/// lights repeat the first light; their results are to be ignored). Evaluated in AVX2
+/// where the CPU has it, else lane by lane by the scalar code: the same bits either way.
 #[derive(Clone, Debug)]
 #[repr(C, align(32))]
 pub struct ImportanceLanes {
@@ -35,19 +37,16 @@ pub struct ImportanceLanes {
 }
 
 impl ImportanceLanes {
-    /// The lanes of `bounds`; `None` where there are none or more than [`LANES`], or the
-    /// CPU lacks AVX2 (the lanes are then never evaluated).
-    pub fn new(bounds: &[ImportanceBounds]) -> Option<ImportanceLanes> {
-        #[cfg(target_arch = "x86_64")]
-        let avx2 = std::arch::is_x86_feature_detected!("avx2");
-        #[cfg(not(target_arch = "x86_64"))]
-        let avx2 = false;
-        if !avx2 || bounds.is_empty() || bounds.len() > LANES {
-            return None;
-        }
+    /// The lanes of `bounds`, one to [`LANES`] of them (lanes past them repeat the first).
+    pub fn new(bounds: &[ImportanceBounds]) -> ImportanceLanes {
+        assert!(
+            (1..=LANES).contains(&bounds.len()),
+            "{} bounds for {LANES} lanes",
+            bounds.len()
+        );
         let at = |i: usize| &bounds[if i < bounds.len() { i } else { 0 }];
         let lanes = |f: &dyn Fn(&ImportanceBounds) -> f32| std::array::from_fn(|i| f(at(i)));
-        Some(ImportanceLanes {
+        ImportanceLanes {
             center: [
                 lanes(&|b| b.center.x),
                 lanes(&|b| b.center.y),
@@ -60,25 +59,50 @@ impl ImportanceLanes {
             sin_theta_o: lanes(&|b| b.sin_theta_o),
             cos_theta_e: lanes(&|b| b.cos_theta_e),
             two_sided: std::array::from_fn(|i| if at(i).two_sided { u32::MAX } else { 0 }),
-        })
+        }
+    }
+
+    /// Lane `i`'s bounds, field for field as they were given.
+    fn bounds(&self, i: usize) -> ImportanceBounds {
+        ImportanceBounds {
+            center: glam::Vec3::new(self.center[0][i], self.center[1][i], self.center[2][i]),
+            radius: self.radius[i],
+            w: glam::Vec3::new(self.w[0][i], self.w[1][i], self.w[2][i]),
+            intensity: self.intensity[i],
+            cos_theta_o: self.cos_theta_o[i],
+            sin_theta_o: self.sin_theta_o[i],
+            cos_theta_e: self.cos_theta_e[i],
+            two_sided: self.two_sided[i] != 0,
+        }
+    }
+
+    /// Each lane's [`ImportanceBounds::importance`] by the scalar code: what
+    /// [`Self::importance`] gives where the CPU lacks AVX2.
+    pub fn importance_scalar(&self, ctx: &ShadingCtx) -> [f32; LANES] {
+        std::array::from_fn(|i| self.bounds(i).importance(ctx))
     }
 
     /// Each lane's [`ImportanceBounds::importance`] at `ctx`, bit for bit.
+    #[inline]
     pub fn importance(&self, ctx: &ShadingCtx) -> [f32; LANES] {
         #[cfg(target_arch = "x86_64")]
-        {
-            let mut out = [0.0f32; LANES];
-            // SAFETY: `new` made lanes only where the CPU has AVX2.
-            unsafe { _mm256_storeu_ps(out.as_mut_ptr(), self.importance_avx2(ctx)) };
-            out
+        if std::arch::is_x86_feature_detected!("avx2") {
+            // SAFETY: the CPU has AVX2.
+            return unsafe { self.importance_avx2(ctx) };
         }
-        #[cfg(not(target_arch = "x86_64"))]
-        unreachable!("ImportanceLanes::new refuses this target")
+        self.importance_scalar(ctx)
     }
 
+    /// [`Self::importance`] in AVX2; inlined into AVX2 callers that evaluate several
+    /// lanes at one point (the light BVH's descent), which then splat the point once.
+    ///
+    /// # Safety
+    ///
+    /// The CPU must have AVX2.
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx,avx2")]
-    fn importance_avx2(&self, ctx: &ShadingCtx) -> __m256 {
+    #[inline]
+    pub fn importance_avx2(&self, ctx: &ShadingCtx) -> [f32; LANES] {
         // SAFETY (loads): every array is LANES f32 in a 32-byte aligned struct, at offsets
         // that are multiples of 32.
         let load = |a: &[f32; LANES]| unsafe { _mm256_load_ps(a.as_ptr()) };
@@ -141,7 +165,12 @@ impl ImportanceLanes {
             let sin_i = safe_sqrt(one_minus_sq(cos_i));
             importance = _mm256_mul_ps(importance, cos_sub(sin_i, cos_i, sin_b, cos_b));
         }
-        select(refused, zero, _mm256_max_ps(importance, zero))
+        let importance = select(refused, zero, _mm256_max_ps(importance, zero));
+        // Stored here, where the intrinsic inlines (outside AVX2 code it was a call).
+        let mut out = [0.0f32; LANES];
+        // SAFETY: `out` holds LANES f32.
+        unsafe { _mm256_storeu_ps(out.as_mut_ptr(), importance) };
+        out
     }
 }
 
@@ -184,9 +213,7 @@ mod tests {
                     ImportanceBounds::new(&lb)
                 })
                 .collect();
-            let Some(lanes) = ImportanceLanes::new(&bounds) else {
-                return; // No AVX2: nothing to compare.
-            };
+            let lanes = ImportanceLanes::new(&bounds);
             for k in 0..8 {
                 let p = Vec3::new(r(-5.0, 5.0), r(-5.0, 5.0), r(-5.0, 5.0));
                 let normal = Vec3::new(r(-1.0, 1.0), r(-1.0, 1.0), r(-1.0, 1.0));
@@ -199,15 +226,16 @@ mod tests {
                     },
                 };
                 let got = lanes.importance(&ctx);
+                let fallback = lanes.importance_scalar(&ctx);
                 for (i, b) in bounds.iter().enumerate() {
                     let want = b.importance(&ctx);
                     assert_eq!(got[i].to_bits(), want.to_bits(), "{round} {k} {i}: {b:?}");
+                    assert_eq!(fallback[i].to_bits(), want.to_bits(), "{round} {k} {i}");
                     compared += (want > 0.0) as u32;
                 }
             }
         }
         // Most pairs weigh something (a test of zeros alone would prove little).
         assert!(compared > 30_000, "{compared}");
-        assert!(ImportanceLanes::new(&[]).is_none());
     }
 }

@@ -2,9 +2,10 @@
 //! binary tree whose nodes carry [`LightBounds`]; sampling descends from the root,
 //! choosing each child in proportion to its importance at the shading point, in
 //! O(log N). The pick probability is the product of the choices along the way, which
-//! [`LightBvh::pmf`] retraces from a per-light bit trail. A tree of at most
-//! [`FLAT_MAX`] lights is not descended: each light is picked by its own bounds'
-//! importance, for about the cost of the descent's two bounds per level (on
+//! [`LightBvh::pmf`] retraces from a per-light bit trail. The descent weighs two levels
+//! (a node's children and grandchildren) in one 8-lane evaluation ([`Descent`]). A tree
+//! of at most [`FLAT_MAX`] lights is not descended: each light is picked by its own
+//! bounds' importance, for the cost of one level's evaluation (on
 //! `scenes/ies-room.toml`, six lights, 0.74× the descent's variance at equal spp:
 //! bench/RESULTS.md, light_sampler).
 //!
@@ -15,6 +16,7 @@
 
 use rayon::join;
 
+use super::descent::{Descent, TreeNode};
 use crate::light::{
     cone_measure, ImportanceBounds, ImportanceLanes, InfiniteImportance, Light, LightBounds,
     ShadingCtx,
@@ -46,19 +48,13 @@ struct Node {
     is_leaf: bool,
 }
 
-/// A node as traversal reads it.
-#[derive(Clone, Copy, Debug)]
-struct FlatNode {
-    bounds: ImportanceBounds,
-    /// As in [`Node`].
-    index: u32,
-    is_leaf: bool,
-}
-
 /// A light BVH over the bounded lights, plus the unbounded ones.
 #[derive(Clone, Debug, Default)]
 pub struct LightBvh {
-    nodes: Vec<FlatNode>,
+    /// The tree's shape; the bounds are in `flat_lanes` or `descent`.
+    nodes: Vec<TreeNode>,
+    /// See [`Self::tree_probability`].
+    p_tree: f32,
     infinite: Vec<u32>,
     /// Per infinite light, what weighs it at a point; empty where some infinite light
     /// has no such measure, or there are fewer than 2 or more than [`INFINITE_MAX`]
@@ -70,8 +66,11 @@ pub struct LightBvh {
     /// Where the tree has at most [`FLAT_MAX`] lights: its leaves' node indices, which
     /// sampling weighs directly; empty otherwise.
     flat: Vec<u32>,
-    /// The bounds of `flat`'s leaves in lanes, weighed at once where the CPU has AVX2.
+    /// The bounds of `flat`'s leaves in lanes, weighed at once.
     flat_lanes: Option<Box<ImportanceLanes>>,
+    /// Where the tree has more than [`FLAT_MAX`] lights: its nodes' bounds in the blocks
+    /// that the descent evaluates two levels at a time.
+    descent: Option<Descent>,
 }
 
 struct Item {
@@ -81,6 +80,16 @@ struct Item {
 }
 
 impl LightBvh {
+    /// The probability of picking the tree rather than one of `infinite` infinite lights
+    /// (1/(n + 1), the tree counting as one more light; 0 without a tree).
+    fn tree_probability(has_tree: bool, infinite: usize) -> f32 {
+        if has_tree {
+            1.0 / (infinite as f32 + 1.0)
+        } else {
+            0.0
+        }
+    }
+
     /// The tree over `lights`; `None` where no light emits.
     pub fn new(lights: &[Light]) -> Option<LightBvh> {
         let mut items = Vec::new();
@@ -112,12 +121,14 @@ impl LightBvh {
             Vec::new()
         };
         let mut bvh = LightBvh {
+            p_tree: Self::tree_probability(!items.is_empty(), infinite.len()),
             nodes: Vec::with_capacity(2 * items.len()),
             infinite,
             infinite_importance,
             trails: vec![0; lights.len()],
             flat: Vec::new(),
             flat_lanes: None,
+            descent: None,
         };
         if !items.is_empty() {
             // A subtree over n lights has exactly 2n − 1 nodes, so every subtree's place in
@@ -131,10 +142,13 @@ impl LightBvh {
             let mut nodes = vec![dummy; 2 * items.len() - 1];
             build(&mut items, 0, &mut nodes, 0);
             drop(items);
+            let bounds: Vec<ImportanceBounds> = nodes
+                .iter()
+                .map(|n| ImportanceBounds::new(&n.bounds))
+                .collect();
             bvh.nodes = nodes
                 .iter()
-                .map(|n| FlatNode {
-                    bounds: ImportanceBounds::new(&n.bounds),
+                .map(|n| TreeNode {
                     index: n.index,
                     is_leaf: n.is_leaf,
                 })
@@ -145,12 +159,11 @@ impl LightBvh {
                 bvh.flat = (0..bvh.nodes.len() as u32)
                     .filter(|&i| bvh.nodes[i as usize].is_leaf)
                     .collect();
-                let bounds: Vec<ImportanceBounds> = bvh
-                    .flat
-                    .iter()
-                    .map(|&i| bvh.nodes[i as usize].bounds)
-                    .collect();
-                bvh.flat_lanes = ImportanceLanes::new(&bounds).map(Box::new);
+                let leaves: Vec<ImportanceBounds> =
+                    bvh.flat.iter().map(|&i| bounds[i as usize]).collect();
+                bvh.flat_lanes = Some(Box::new(ImportanceLanes::new(&leaves)));
+            } else {
+                bvh.descent = Some(Descent::new(&bvh.nodes, &bounds));
             }
         }
         Some(bvh)
@@ -174,12 +187,9 @@ impl LightBvh {
     }
 
     /// Probability of picking the tree rather than an infinite light.
+    #[inline]
     fn p_tree(&self) -> f32 {
-        if self.nodes.is_empty() {
-            0.0
-        } else {
-            1.0 / (self.infinite.len() as f32 + 1.0)
-        }
+        self.p_tree
     }
 
     /// A light and its probability at `ctx`; `None` where no light in the tree can reach
@@ -195,31 +205,7 @@ impl LightBvh {
         if !self.flat.is_empty() {
             return self.sample_flat(ctx, u).map(|(i, p)| (i, p_tree * p));
         }
-        let mut pmf = p_tree;
-        let mut at = 0usize;
-        loop {
-            let node = &self.nodes[at];
-            if node.is_leaf {
-                // A single light whose bounds say it cannot reach the point.
-                return (at > 0 || node.bounds.importance(ctx) > 0.0).then_some((node.index, pmf));
-            }
-            let (a, b) = (at + 1, node.index as usize);
-            let ia = self.nodes[a].bounds.importance(ctx);
-            let ib = self.nodes[b].bounds.importance(ctx);
-            if ia + ib <= 0.0 || (ia + ib).is_nan() {
-                return None;
-            }
-            let pa = ia / (ia + ib);
-            if u < pa {
-                u = (u / pa).min(ONE_MINUS_EPSILON);
-                pmf *= pa;
-                at = a;
-            } else {
-                u = ((u - pa) / (1.0 - pa)).min(ONE_MINUS_EPSILON);
-                pmf *= 1.0 - pa;
-                at = b;
-            }
-        }
+        self.descent.as_ref()?.sample(ctx, u, p_tree)
     }
 
     /// Probability that [`Self::sample`] picks `light` at `ctx`.
@@ -234,46 +220,21 @@ impl LightBvh {
         if !self.flat.is_empty() {
             return self.p_tree() * self.flat_pmf(ctx, light);
         }
-        let depth = 63 - trail.leading_zeros();
-        let mut pmf = self.p_tree();
-        let mut at = 0usize;
-        for level in 0..depth {
-            let node = &self.nodes[at];
-            let (a, b) = (at + 1, node.index as usize);
-            let ia = self.nodes[a].bounds.importance(ctx);
-            let ib = self.nodes[b].bounds.importance(ctx);
-            if ia + ib <= 0.0 || (ia + ib).is_nan() {
-                return 0.0;
-            }
-            let pa = ia / (ia + ib);
-            if trail & (1 << level) == 0 {
-                pmf *= pa;
-                at = a;
-            } else {
-                pmf *= 1.0 - pa;
-                at = b;
-            }
+        match &self.descent {
+            Some(d) => d.pmf(ctx, trail, self.p_tree()),
+            None => 0.0,
         }
-        if depth == 0 && self.nodes[0].bounds.importance(ctx) <= 0.0 {
-            return 0.0;
-        }
-        pmf
     }
 
     /// The importances of the flat tree's leaves at `ctx` (in the order of `flat`) and
     /// their sum.
     #[inline]
     fn flat_weights(&self, ctx: &ShadingCtx) -> ([f32; FLAT_MAX], f32) {
-        let mut w = [0.0f32; FLAT_MAX];
-        match &self.flat_lanes {
-            // The same bits as the loop below, eight lights in one evaluation.
-            Some(lanes) => w = lanes.importance(ctx),
-            None => {
-                for (w, &leaf) in w.iter_mut().zip(&self.flat) {
-                    *w = self.nodes[leaf as usize].bounds.importance(ctx);
-                }
-            }
-        }
+        let w = match &self.flat_lanes {
+            // Every light's own importance, eight lights in one evaluation.
+            Some(lanes) => lanes.importance(ctx),
+            None => [0.0; FLAT_MAX],
+        };
         let mut total = 0.0;
         for &w in &w[..self.flat.len()] {
             total += w;
@@ -288,7 +249,7 @@ impl LightBvh {
     /// and picks that follow each light rather than its cluster.
     fn sample_flat(&self, ctx: &ShadingCtx, u: f32) -> Option<(u32, f32)> {
         let (w, total) = self.flat_weights(ctx);
-        if total <= 0.0 || !total.is_finite() {
+        if !positive_finite(total) {
             return None;
         }
         let target = u * total;
@@ -309,7 +270,7 @@ impl LightBvh {
     /// Probability that [`Self::sample_flat`] picks `light` at `ctx`.
     fn flat_pmf(&self, ctx: &ShadingCtx, light: u32) -> f32 {
         let (w, total) = self.flat_weights(ctx);
-        if total <= 0.0 || !total.is_finite() {
+        if !positive_finite(total) {
             return 0.0;
         }
         self.flat
@@ -332,7 +293,7 @@ impl LightBvh {
             *w = m.at(ctx).max(0.0);
             total += *w;
         }
-        (total > 0.0 && total.is_finite()).then_some((w, total))
+        positive_finite(total).then_some((w, total))
     }
 
     /// One of the infinite lights (its index in `infinite`) and its probability among
@@ -367,12 +328,24 @@ impl LightBvh {
 
     /// Bytes held, for the benchmark's memory note.
     pub fn memory_bytes(&self) -> usize {
-        self.nodes.len() * std::mem::size_of::<FlatNode>() + 8 * self.trails.len()
+        self.nodes.len() * std::mem::size_of::<TreeNode>()
+            + 8 * self.trails.len()
+            + self
+                .flat_lanes
+                .as_ref()
+                .map_or(0, |_| size_of::<ImportanceLanes>())
+            + self.descent.as_ref().map_or(0, Descent::memory_bytes)
     }
 
     pub fn node_count(&self) -> usize {
         self.nodes.len()
     }
+}
+
+/// Whether `x` is positive and finite (what a sum of weights must be to pick by it).
+#[inline(always)]
+fn positive_finite(x: f32) -> bool {
+    x > 0.0 && x < f32::INFINITY
 }
 
 /// SAOH cost of a cluster (pbrt-v4's `EvaluateCost`): intensity × orientation measure

@@ -16,6 +16,7 @@
 
 mod array;
 mod bvh;
+mod descent;
 pub mod ris;
 
 pub use array::LightArray;

@@ -124,6 +124,9 @@ fn sample_unit_slope(cos_theta: f32, sin_theta: f32, u: Vec2) -> (f32, f32) {
     let tan_over_sqrt_pi = tan_theta * FRAC_1_SQRT_PI;
     let norm = 1.0 / (1.0 + c + tan_over_sqrt_pi * (-cot_theta * cot_theta).exp());
     let (mut lo, mut hi) = (-1.0f32, c);
+    // erfinv of the b the iteration converged at: what the last step below would
+    // recompute (b is unchanged since, and inside [lo, hi], so that step keeps it).
+    let mut converged = None;
     for _ in 0..10 {
         // Also catches a NaN step.
         if !(b >= lo && b <= hi) {
@@ -132,6 +135,7 @@ fn sample_unit_slope(cos_theta: f32, sin_theta: f32, u: Vec2) -> (f32, f32) {
         let x = erfinv(b.clamp(-B_MAX, B_MAX));
         let value = norm * (1.0 + b + tan_over_sqrt_pi * (-x * x).exp()) - ux;
         if value.abs() < 1e-5 {
+            converged = Some(x);
             break;
         }
         if value > 0.0 {
@@ -142,10 +146,12 @@ fn sample_unit_slope(cos_theta: f32, sin_theta: f32, u: Vec2) -> (f32, f32) {
         let derivative = norm * (1.0 - x * tan_theta);
         b -= value / derivative;
     }
-    if !(b >= lo && b <= hi) {
-        b = 0.5 * (lo + hi);
-    }
-    let sx = erfinv(b.clamp(-B_MAX, B_MAX));
+    let sx = converged.unwrap_or_else(|| {
+        if !(b >= lo && b <= hi) {
+            b = 0.5 * (lo + hi);
+        }
+        erfinv(b.clamp(-B_MAX, B_MAX))
+    });
     let sy = erfinv((2.0 * u.y.max(1e-6) - 1.0).clamp(-B_MAX, B_MAX));
     (sx, sy)
 }
@@ -185,6 +191,70 @@ pub fn erfinv(x: f32) -> f32 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// [`sample_unit_slope`] as it was, erfinv recomputed after convergence.
+    fn sample_unit_slope_reference(cos_theta: f32, sin_theta: f32, u: Vec2) -> (f32, f32) {
+        // Keeps b and 2u₂ − 1 inside (−1, 1), where erfinv is finite (it is ±3.9 there).
+        const B_MAX: f32 = 1.0 - f32::EPSILON / 2.0;
+        let cos_theta = cos_theta.max(1e-7);
+        let tan_theta = sin_theta / cos_theta;
+        let cot_theta = cos_theta / sin_theta; // ∞ at normal incidence: c = 1, e^(−∞) = 0
+        let c = libm::erff(cot_theta);
+        let ux = u.x.max(1e-6);
+        let theta = cos_theta.min(1.0).acos();
+        let fit = 1.0 + theta * (-0.876 + theta * (0.4265 - 0.0594 * theta));
+        let mut b = c - (1.0 + c) * (1.0 - ux).powf(fit);
+        let tan_over_sqrt_pi = tan_theta * FRAC_1_SQRT_PI;
+        let norm = 1.0 / (1.0 + c + tan_over_sqrt_pi * (-cot_theta * cot_theta).exp());
+        let (mut lo, mut hi) = (-1.0f32, c);
+        for _ in 0..10 {
+            // Also catches a NaN step.
+            if !(b >= lo && b <= hi) {
+                b = 0.5 * (lo + hi);
+            }
+            let x = erfinv(b.clamp(-B_MAX, B_MAX));
+            let value = norm * (1.0 + b + tan_over_sqrt_pi * (-x * x).exp()) - ux;
+            if value.abs() < 1e-5 {
+                break;
+            }
+            if value > 0.0 {
+                hi = b;
+            } else {
+                lo = b;
+            }
+            let derivative = norm * (1.0 - x * tan_theta);
+            b -= value / derivative;
+        }
+        if !(b >= lo && b <= hi) {
+            b = 0.5 * (lo + hi);
+        }
+        let sx = erfinv(b.clamp(-B_MAX, B_MAX));
+        let sy = erfinv((2.0 * u.y.max(1e-6) - 1.0).clamp(-B_MAX, B_MAX));
+        (sx, sy)
+    }
+
+    /// Reusing the converged erfinv gives the same slopes, bit for bit, over random
+    /// directions (grazing to normal incidence) and numbers.
+    #[test]
+    fn unit_slope_keeps_its_bits() {
+        let mut state = 0x9e37_79b9_7f4a_7c15u64;
+        let mut uniform = move || {
+            state = crate::sampler::mix64(state);
+            (state >> 40) as f32 / (1u64 << 24) as f32
+        };
+        for i in 0..200_000 {
+            let cos_theta = if i % 97 == 0 { 1.0 } else { uniform() };
+            let sin_theta = (1.0 - cos_theta * cos_theta).max(0.0).sqrt();
+            let u = Vec2::new(uniform(), uniform());
+            let (x, y) = sample_unit_slope(cos_theta, sin_theta, u);
+            let (rx, ry) = sample_unit_slope_reference(cos_theta, sin_theta, u);
+            assert_eq!(
+                (x.to_bits(), y.to_bits()),
+                (rx.to_bits(), ry.to_bits()),
+                "{i}"
+            );
+        }
+    }
 
     /// erfinv(y) for f32 y, in f64: bisection on `libm::erf` (f64, accurate to an ulp).
     fn erfinv_reference(y: f32) -> f64 {
