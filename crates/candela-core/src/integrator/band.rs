@@ -70,13 +70,17 @@ pub(super) fn render_pixels<S: Sampler, K: SampleSink, const V3: bool>(
 ) -> RenderStats {
     let Band { rows, width, pass } = band;
     let mut stats = RenderStats::default();
-    let pixels = rows.flat_map(|y| (0..width).map(move |x| UVec2::new(x, y)));
-    for p in pixels {
-        for index in pass.clone() {
-            let (film_pos, ray) = camera_ray(scene, sampler, p, index, K::SPLATS);
-            let l = li_isa::<S, V3>(scene, ray, sampler, &mut stats.rays);
-            stats.paths += 1;
-            sink.add(p, film_pos, l);
+    // Plain nested loops: a `flat_map` over the rows kept its inner iterator's state in
+    // memory, some fifty instructions a path of loads, stores and tests.
+    for y in rows {
+        for x in 0..width {
+            let p = UVec2::new(x, y);
+            for index in pass.clone() {
+                let (film_pos, ray) = camera_ray(scene, sampler, p, index, K::SPLATS);
+                let l = li_isa::<S, V3>(scene, ray, sampler, &mut stats.rays);
+                stats.paths += 1;
+                sink.add(p, film_pos, l);
+            }
         }
     }
     stats
