@@ -71,7 +71,7 @@ pub(super) fn render_pixels<S: Sampler, K: SampleSink>(
     let Band { rows, width, pass } = band;
     let mut stats = RenderStats::default();
     // Plain nested loops: a `flat_map` over the rows kept its inner iterator's state in
-    // memory, some fifty instructions a path of loads, stores and tests.
+    // memory (about ten instructions a path more).
     for y in rows {
         for x in 0..width {
             let p = UVec2::new(x, y);

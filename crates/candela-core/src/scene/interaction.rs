@@ -120,8 +120,7 @@ pub(super) fn triangle_interaction(
 }
 
 /// [`full_triangle_interaction`] of a world-space mesh: a copy of its own, out of line,
-/// in which every test of the instance folds away (a dozen instructions a hit of
-/// choosing between the instance's and the mesh's material and flip, and the transforms).
+/// in which every test of the instance (its material, flip and transform) folds away.
 #[inline(never)]
 fn world_triangle_interaction(m: &Mesh, tri: u32, t: f32, bary: Vec2) -> SurfaceInteraction {
     full_triangle_interaction(m, None, tri, t, bary)
