@@ -6,7 +6,7 @@ use std::ops::Range;
 
 use glam::{UVec2, Vec2, Vec3};
 
-use super::path::li_isa;
+use super::path::li;
 use super::RenderStats;
 use crate::filter::PixelFilter;
 use crate::geometry::Ray;
@@ -59,10 +59,10 @@ pub(crate) fn camera_ray<S: Sampler>(
 }
 
 /// Takes a band's samples; inlined into each copy of the render loop, so that it and
-/// its callees are compiled for each. `V3`: whether this is the x86-64-v3 copy (which
-/// then calls the v3 copy of next event estimation).
+/// its callees (the path loop and its next event estimation included) are compiled for
+/// each.
 #[inline(always)]
-pub(super) fn render_pixels<S: Sampler, K: SampleSink, const V3: bool>(
+pub(super) fn render_pixels<S: Sampler, K: SampleSink>(
     scene: &Scene,
     sampler: &mut S,
     band: Band,
@@ -70,13 +70,17 @@ pub(super) fn render_pixels<S: Sampler, K: SampleSink, const V3: bool>(
 ) -> RenderStats {
     let Band { rows, width, pass } = band;
     let mut stats = RenderStats::default();
-    let pixels = rows.flat_map(|y| (0..width).map(move |x| UVec2::new(x, y)));
-    for p in pixels {
-        for index in pass.clone() {
-            let (film_pos, ray) = camera_ray(scene, sampler, p, index, K::SPLATS);
-            let l = li_isa::<S, V3>(scene, ray, sampler, &mut stats.rays);
-            stats.paths += 1;
-            sink.add(p, film_pos, l);
+    // Plain nested loops: a `flat_map` over the rows kept its inner iterator's state in
+    // memory (about ten instructions a path more).
+    for y in rows {
+        for x in 0..width {
+            let p = UVec2::new(x, y);
+            for index in pass.clone() {
+                let (film_pos, ray) = camera_ray(scene, sampler, p, index, K::SPLATS);
+                let l = li(scene, ray, sampler, &mut stats.rays);
+                stats.paths += 1;
+                sink.add(p, film_pos, l);
+            }
         }
     }
     stats

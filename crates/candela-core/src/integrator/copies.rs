@@ -1,7 +1,8 @@
 //! The compiled copies of the render loop: one for the build's target (baseline) and,
 //! on x86-64, one for x86-64-v3 (AVX2, FMA, BMI1/2), chosen per render by
 //! [`crate::options::Isa`] (see [`crate::isa`]). A copy is the band loop and everything it
-//! inlines; next event estimation, kept out of line, has a copy of its own for each.
+//! inlines. The lanes integrator keeps next event estimation out of line, with a copy of
+//! its own for each; the path loop inlines it.
 
 use glam::Vec3;
 
@@ -33,7 +34,7 @@ v3_fn! {
         band: Band,
         sink: &mut K,
     ) -> RenderStats {
-        render_pixels::<S, K, true>(scene, sampler, band, sink)
+        render_pixels(scene, sampler, band, sink)
     }
 }
 
@@ -67,13 +68,13 @@ pub(crate) fn render_band<S: Sampler, K: SampleSink>(
         (Isa::V3, false) => unsafe { render_pixels_v3(scene, sampler, band, sink) },
         #[cfg(target_arch = "x86_64")]
         (Isa::V3, true) => unsafe { render_lanes_v3(scene, sampler, band, sink) },
-        (_, false) => render_pixels::<S, K, false>(scene, sampler, band, sink),
+        (_, false) => render_pixels(scene, sampler, band, sink),
         (_, true) => render_lanes::<S, K, false>(scene, sampler, band, sink),
     }
 }
 
-/// [`sample_direct`] for the baseline target, out of line (inlined into the loop it
-/// measured slower).
+/// [`sample_direct`] for the baseline target, out of line: the lanes integrator's (see
+/// `path::direct_out_of_line`).
 #[inline(never)]
 pub(super) fn sample_direct_baseline(scene: &Scene, v: &NeeVertex, rays: &mut u64) -> Vec3 {
     sample_direct(scene, v, rays)
@@ -81,7 +82,7 @@ pub(super) fn sample_direct_baseline(scene: &Scene, v: &NeeVertex, rays: &mut u6
 
 v3_fn! {
     /// [`sample_direct`] compiled for x86-64-v3, out of line, called by the v3 copy of the
-    /// loop.
+    /// lanes loop.
     #[inline(never)]
     pub(super) fn sample_direct_v3(scene: &Scene, v: &NeeVertex, rays: &mut u64) -> Vec3 {
         sample_direct(scene, v, rays)

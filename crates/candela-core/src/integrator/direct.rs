@@ -36,18 +36,21 @@ pub(super) struct NeeVertex<'a> {
 /// shadow ray, and the MIS weight against BSDF sampling of the same direction.
 #[inline(always)]
 pub(super) fn sample_direct(scene: &Scene, v: &NeeVertex, rays: &mut u64) -> Vec3 {
-    let NeeVertex {
-        si,
-        ctx,
-        bsdf,
-        wo,
-        u_light,
-        u_point,
-    } = *v;
+    // The vertex's fields are read where they are used, from `v`, not copied out first:
+    // copied, they lived in registers across the light sampler's call, so each was
+    // stored to the stack before it and loaded back after it.
     let mode = scene.settings.mis;
-    let Some(pick) = scene.light_sampler.sample(ctx, u_light, &scene.lights) else {
+    let ctx = v.ctx;
+    let Some(pick) = scene.light_sampler.sample(ctx, v.u_light, &scene.lights) else {
         return Vec3::ZERO;
     };
+    let NeeVertex {
+        si,
+        bsdf,
+        wo,
+        u_point,
+        ..
+    } = *v;
     let id = pick.id;
     let light = scene.light(id);
     // BSDF-only estimation still needs NEE for delta lights, which no ray can hit.

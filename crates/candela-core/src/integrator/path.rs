@@ -7,7 +7,7 @@ use glam::{Vec2, Vec3};
 use super::copies::sample_direct_baseline;
 #[cfg(target_arch = "x86_64")]
 use super::copies::sample_direct_v3;
-use super::direct::{mis_weight, NeeVertex};
+use super::direct::{mis_weight, sample_direct, NeeVertex};
 use super::volpath;
 use crate::bsdf::Bsdf;
 use crate::geometry::Ray;
@@ -17,20 +17,10 @@ use crate::options::MisMode;
 use crate::sampler::Sampler;
 use crate::scene::{Scene, SurfaceInteraction};
 
-/// Radiance arriving along `ray`, estimated by one path.
+/// Radiance arriving along `ray`, estimated by one path; inlined into each copy of the
+/// render loop (see [`super::band::render_pixels`]).
 #[inline(always)]
-pub fn li<S: Sampler>(scene: &Scene, ray: Ray, sampler: &mut S, rays: &mut u64) -> Vec3 {
-    li_isa::<S, false>(scene, ray, sampler, rays)
-}
-
-/// [`li`] in the copy of the render loop `V3` says (see [`super::band::render_pixels`]).
-#[inline(always)]
-pub(super) fn li_isa<S: Sampler, const V3: bool>(
-    scene: &Scene,
-    mut ray: Ray,
-    sampler: &mut S,
-    rays: &mut u64,
-) -> Vec3 {
+pub fn li<S: Sampler>(scene: &Scene, mut ray: Ray, sampler: &mut S, rays: &mut u64) -> Vec3 {
     if let Some(media) = scene.media.as_deref() {
         return volpath::li(scene, media, ray, sampler, rays);
     }
@@ -85,7 +75,7 @@ pub(super) fn li_isa<S: Sampler, const V3: bool>(
         };
         let bs = bsdf.sample(wo, u_lobe, u.dir);
         if !bsdf.is_delta() {
-            l += beta * direct::<S, V3>(scene, si, &ctx, &bsdf, wo, &u, rays);
+            l += beta * direct::<S>(scene, si, &ctx, &bsdf, wo, &u, rays);
         }
         let Some(bs) = bs else {
             break;
@@ -204,9 +194,12 @@ pub(super) fn add_emitted(
 }
 
 /// Next event estimation at the hit `si` (shading context `ctx`, BSDF `bsdf`, towards
-/// `wo`) with the bounce's light numbers in `u`, in the copy of the render loop `V3` says.
+/// `wo`) with the bounce's light numbers in `u`, inlined into the path loop. Out of line
+/// (as it was, and still is for the lanes integrator: [`direct_out_of_line`]) the call
+/// cost the loop about 50 instructions a bounce: the vertex record written to the stack,
+/// the callee's saves and restores, and the loop's values spilled around the call.
 #[inline(always)]
-pub(super) fn direct<S: Sampler, const V3: bool>(
+pub(super) fn direct<S: Sampler>(
     scene: &Scene,
     si: &SurfaceInteraction,
     ctx: &ShadingCtx,
@@ -215,20 +208,49 @@ pub(super) fn direct<S: Sampler, const V3: bool>(
     u: &BounceSamples<S>,
     rays: &mut u64,
 ) -> Vec3 {
-    let v = NeeVertex {
-        si,
-        ctx,
-        bsdf,
-        wo,
-        u_light: u.light,
-        u_point: u.point,
-    };
+    sample_direct(scene, &NeeVertex::new(si, ctx, bsdf, wo, u), rays)
+}
+
+/// [`direct`] out of line, in the copy of the render loop `V3` says: the lanes
+/// integrator's, whose shading of one lane at a time keeps it there.
+#[inline(always)]
+pub(super) fn direct_out_of_line<S: Sampler, const V3: bool>(
+    scene: &Scene,
+    si: &SurfaceInteraction,
+    ctx: &ShadingCtx,
+    bsdf: &Bsdf,
+    wo: Vec3,
+    u: &BounceSamples<S>,
+    rays: &mut u64,
+) -> Vec3 {
+    let v = NeeVertex::new(si, ctx, bsdf, wo, u);
     match V3 {
         // SAFETY: only the v3 copy of the render loop has `V3`, and `render_with` asserted
         // that the CPU runs it.
         #[cfg(target_arch = "x86_64")]
         true => unsafe { sample_direct_v3(scene, &v, rays) },
         _ => sample_direct_baseline(scene, &v, rays),
+    }
+}
+
+impl<'a> NeeVertex<'a> {
+    /// The vertex of the hit `si` with the bounce's light numbers in `u`.
+    #[inline(always)]
+    fn new<S: Sampler>(
+        si: &'a SurfaceInteraction,
+        ctx: &'a ShadingCtx,
+        bsdf: &'a Bsdf,
+        wo: Vec3,
+        u: &BounceSamples<S>,
+    ) -> NeeVertex<'a> {
+        NeeVertex {
+            si,
+            ctx,
+            bsdf,
+            wo,
+            u_light: u.light,
+            u_point: u.point,
+        }
     }
 }
 

@@ -112,15 +112,22 @@ pub(super) fn triangle_interaction(
     t: f32,
     bary: Vec2,
 ) -> SurfaceInteraction {
-    if inst.is_none() && m.is_bare() {
-        bare_triangle_interaction(m, tri, t, bary)
-    } else {
-        full_triangle_interaction(m, inst, tri, t, bary)
+    match inst {
+        None if m.is_bare() => bare_triangle_interaction(m, tri, t, bary),
+        None => world_triangle_interaction(m, tri, t, bary),
+        Some(_) => full_triangle_interaction(m, inst, tri, t, bary),
     }
 }
 
+/// [`full_triangle_interaction`] of a world-space mesh: a copy of its own, out of line,
+/// in which every test of the instance (its material, flip and transform) folds away.
+#[inline(never)]
+fn world_triangle_interaction(m: &Mesh, tri: u32, t: f32, bary: Vec2) -> SurfaceInteraction {
+    full_triangle_interaction(m, None, tri, t, bary)
+}
+
 /// [`triangle_interaction`] with every vertex attribute the mesh has interpolated.
-#[inline]
+#[inline(always)]
 fn full_triangle_interaction(
     m: &Mesh,
     inst: Option<&Instance>,
@@ -129,16 +136,24 @@ fn full_triangle_interaction(
     bary: Vec2,
 ) -> SurfaceInteraction {
     let xf = inst.map(|i| &i.transform);
-    let normal = |i: usize| xf.map_or(m.normals[i], |x| x.normal(m.normals[i]));
     let flip_normals = inst.map_or(m.flip_normals, |i| i.flip_normals);
     let material = inst.map_or(m.material, |i| i.material);
-    let tangent = |i: usize| xf.map_or(m.tangents[i], |x| x.tangent(m.tangents[i]));
     let [a, b, c] = m.indices[tri as usize].map(|i| i as usize);
     let [p0, p1, p2] = match xf {
         None => m.vertices(tri),
         Some(x) => m.vertices(tri).map(|p| x.point(p)),
     };
-    let normals = (!m.normals.is_empty()).then(|| [normal(a), normal(b), normal(c)]);
+    // An `if`, not `bool::then` with a closure, which LLVM left out of line.
+    let normals = if m.normals.is_empty() {
+        None
+    } else {
+        let n = [m.normals[a], m.normals[b], m.normals[c]];
+        Some([
+            carried_normal(xf, n[0]),
+            carried_normal(xf, n[1]),
+            carried_normal(xf, n[2]),
+        ])
+    };
     let b0 = 1.0 - bary.x - bary.y;
     // Barycentric interpolation is more accurate than o + t·d.
     let p = p0 * b0 + p1 * bary.x + p2 * bary.y;
@@ -154,12 +169,20 @@ fn full_triangle_interaction(
     if let Some([na, nb, nc]) = normals {
         let n = (na * b0 + nb * bary.x + nc * bary.y).normalize_or_zero();
         if n != Vec3::ZERO {
-            ns = if flip_normals { -n } else { n };
+            // A product with ±1, exact (n is finite here: `normalize_or_zero` gives zero
+            // for anything else), where the select of −n or n was a broadcast mask.
+            ns = negated_unless(n, !flip_normals);
         }
     }
-    let uv = m.uv_at(tri, bary);
+    // `Mesh::uv_at`'s sum, from the indices already loaded.
+    let uv = if m.uvs.is_empty() {
+        bary
+    } else {
+        m.uvs[a] * b0 + m.uvs[b] * bary.x + m.uvs[c] * bary.y
+    };
     let light = m.lights.get(tri as usize).copied();
     let (dpdu, bitangent_sign) = if !m.tangents.is_empty() {
+        let tangent = |i: usize| xf.map_or(m.tangents[i], |x| x.tangent(m.tangents[i]));
         let t = tangent(a) * b0 + tangent(b) * bary.x + tangent(c) * bary.y;
         (t.truncate(), if t.w < 0.0 { -1.0 } else { 1.0 })
     } else if m.uvs.is_empty() {
@@ -185,6 +208,15 @@ fn full_triangle_interaction(
         color,
         material,
         light,
+    }
+}
+
+/// A vertex normal carried to world space by the instance transform `xf`, if any.
+#[inline(always)]
+fn carried_normal(xf: Option<&crate::instance::Transform>, n: Vec3) -> Vec3 {
+    match xf {
+        None => n,
+        Some(x) => x.normal(n),
     }
 }
 

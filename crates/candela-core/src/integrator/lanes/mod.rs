@@ -33,7 +33,7 @@ use self::simd::Avx2;
 use self::simd::{F32x8, LaneIsa, Lanes32, M32x8, Portable, Vec3Lanes, Vec3x8, LANES};
 use self::state::PathLanes;
 use super::band::{camera_ray, Band, SampleSink};
-use super::path::{add_emitted, add_escaped, direct, hides_emitter, BounceSamples};
+use super::path::{add_emitted, add_escaped, direct_out_of_line, hides_emitter, BounceSamples};
 use super::RenderStats;
 use crate::bsdf::Lobe;
 use crate::light::ShadingCtx;
@@ -258,7 +258,7 @@ fn shade_lane<S: Sampler, const V3: bool>(
         }
     };
     if !bsdf.is_delta() {
-        *l += beta * direct::<S, V3>(scene, si, &ctx, &bsdf, wo, &u, rays);
+        *l += beta * direct_out_of_line::<S, V3>(scene, si, &ctx, &bsdf, wo, &u, rays);
     }
     match sampled {
         None => {}
@@ -305,7 +305,7 @@ fn advance<I: LaneIsa, S>(lanes: &mut PathLanes<S>, b: &mut BounceLanes) -> u8 {
     let beta = old_beta.mul(&f.scale(cos / pdf));
     let old_eta_scale = F32x8::load(&lanes.eta_scale);
     let eta_scale = old_eta_scale * F32x8::load(&b.eta_crossed_sq);
-    // Survival in proportion to the throughput (see `path::li_isa`).
+    // Survival in proportion to the throughput (see `path::li`).
     let one = F32x8::splat(1.0);
     let q = (one - beta.max_component() * eta_scale).max(F32x8::splat(0.0));
     let roulette = M32x8::from_bools(b.roulette);
