@@ -12,7 +12,9 @@
 //! Leaves are blocks of up to eight lanes, so these scenes hold blocks of every fill, and
 //! the soup mixes spheres among its triangles (`accel::block`'s own test checks each
 //! fill and mix lane by lane). Scenes of one leaf (one triangle; a block of triangles and
-//! spheres) take the queries' path without box tests.
+//! spheres) take the queries' path without box tests, and a scene of one node over four
+//! leaves the path without the traversal's stack; both must also return the traversal's
+//! own hits bit for bit (`small_trees_find_the_traversals_hits`).
 //!
 //! Every SIMD kernel set the CPU has (`Simd::available`, always including the scalar
 //! fallback) is checked the same way, with both node layouts (full planes and quantized
@@ -292,6 +294,7 @@ fn same_hits_as_brute_force_and_the_binary_bvh() {
     scenes.push(("degenerate", degenerate));
     scenes.push(("one triangle", vec![one]));
     scenes.push(("one block", one_block(&mut rng)));
+    scenes.push(("one node", one_node(&mut rng)));
     scenes.push(("empty", vec![]));
 
     for (name, shapes) in &scenes {
@@ -341,6 +344,41 @@ fn one_block(rng: &mut Pcg32) -> Vec<Shape> {
     shapes
 }
 
+/// Three clusters of five triangles and a sphere, far apart, and ten copies of one
+/// triangle: a tree of one node over four or more leaves, whose boxes a ray may enter in
+/// any order.
+fn one_node(rng: &mut Pcg32) -> Vec<Shape> {
+    let mut shapes = Vec::new();
+    for corner in [
+        Vec3::ZERO,
+        Vec3::new(4.0, 0.0, 0.0),
+        Vec3::new(0.0, 4.0, 4.0),
+    ] {
+        let mut block = one_block(rng);
+        block.truncate(6);
+        for s in &mut block {
+            match s {
+                Shape::Triangle(v) => v.iter_mut().for_each(|p| *p += corner),
+                Shape::Sphere { center, .. } => *center += corner,
+            }
+        }
+        shapes.extend(block);
+    }
+    // Ten copies of one triangle: more than a leaf holds, so two leaves with the same box,
+    // entered at the same distance, with hits at the same distance (ties the order of
+    // the leaves decides).
+    shapes.extend((0..10).map(|_| Shape::Triangle(COPIED.map(|p| p + COPIES_AT))));
+    shapes
+}
+
+/// The triangle `one_node` copies, and where.
+const COPIED: [Vec3; 3] = [
+    Vec3::ZERO,
+    Vec3::new(1.0, 1.0, 0.0),
+    Vec3::new(0.0, 1.0, 1.0),
+];
+const COPIES_AT: Vec3 = Vec3::new(4.0, 4.0, 0.0);
+
 /// A tree of one leaf is recognised (its queries skip the box test; the scenes "one
 /// triangle" and "one block" above check their hits), and one that needs two leaves is not.
 #[test]
@@ -361,6 +399,77 @@ fn a_tree_of_one_leaf_is_recognised() {
     assert_eq!(sole(&[one; 9]), None);
     assert_eq!(sole(&random_soup(&mut rng, 40, 4)), None);
     assert_eq!(sole(&[]), None);
+}
+
+/// The queries of trees of one node (one leaf; several leaves) return exactly what the
+/// traversal returns on the same structure (the same primitive even in ties, the same
+/// bits), with every kernel and layout: the images do not change where they apply.
+#[test]
+fn small_trees_find_the_traversals_hits() {
+    let mut rng = Pcg32::new(35, 4);
+    let scenes = [
+        ("one block", one_block(&mut rng)),
+        ("one node", one_node(&mut rng)),
+        ("one node", one_node(&mut rng)),
+    ];
+    let key = |h: Option<Hit>| h.map(|h| (h.prim, h.t.to_bits(), h.b1.to_bits(), h.b2.to_bits()));
+    for (name, shapes) in &scenes {
+        let mut rays = random_rays(&mut rng, shapes, bounds_of(shapes), 6000);
+        // At the copied triangle (two leaves with the same box): ties between leaves.
+        let centroid = (COPIED[0] + COPIED[1] + COPIED[2]) / 3.0 + COPIES_AT;
+        rays.extend((0..2000).map(|_| {
+            let aim = centroid + (v3(&mut rng) - 0.5) * 0.3;
+            let d = (v3(&mut rng) - 0.5).normalize_or(Vec3::Y);
+            Ray::new(aim - d * 8.0, d)
+        }));
+        let mut hits = 0;
+        for (simd, layout) in kernels_and_layouts() {
+            let accel = Accel::build_layout(shapes, |_| false, simd, layout);
+            let traversal = accel.clone().without_shortcut();
+            for (k, ray) in rays.iter().enumerate() {
+                let t_max = [f32::INFINITY, 6.0, 0.5][k % 3];
+                let (a, b) = (
+                    accel.intersect(ray, t_max, accept_all),
+                    traversal.intersect(ray, t_max, accept_all),
+                );
+                assert_eq!(
+                    key(a),
+                    key(b),
+                    "{name} {simd:?} {layout:?}: ray {k} {ray:?}"
+                );
+                assert_eq!(
+                    accel.occluded(ray, t_max, accept_all),
+                    b.is_some(),
+                    "{name} {simd:?} {layout:?}: any-hit, ray {k}"
+                );
+                hits += b.is_some() as usize;
+            }
+        }
+        assert!(hits > 10000, "{name}: only {hits} hits");
+    }
+}
+
+/// A tree of one node over several leaves is recognised (its queries take no stack; the
+/// scene "one node" above checks their hits with every kernel and layout), and a bigger
+/// one is not.
+#[test]
+fn a_tree_of_one_node_is_recognised() {
+    let mut rng = Pcg32::new(35, 3);
+    let tree = |shapes: &[Shape]| {
+        let boxes = boxes(shapes);
+        let bvh = Bvh::build_from(boxes.len(), |i| boxes[i], SahCost::BLOCKS);
+        WideBvh::collapse(&bvh)
+    };
+    for _ in 0..20 {
+        let wide = tree(&one_node(&mut rng));
+        let root = wide.sole_node().expect("one node");
+        assert!(root.leaves.count_ones() >= 4, "{} leaves", root.leaves);
+        assert_eq!(wide.sole_leaf(), None);
+    }
+    let one = Shape::Triangle([Vec3::ZERO, Vec3::X, Vec3::Y]);
+    assert!(tree(&[one]).sole_node().is_some());
+    assert!(tree(&random_soup(&mut rng, 400, 4)).sole_node().is_none());
+    assert!(tree(&[]).sole_node().is_none());
 }
 
 #[test]

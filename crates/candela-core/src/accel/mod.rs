@@ -2,9 +2,9 @@
 //! scene's primitives, each leaf's primitives copied into one [`block::Block`] of eight
 //! lanes with the vertices inline (no index → mesh → position chase), tested eight at a
 //! time. The build sizes leaves knowing that a leaf of up to eight triangles costs one
-//! block test ([`SahCost::BLOCKS`]). A tree of one node over one leaf (a scene whose
-//! primitives fit one block) is queried by that block's test alone, without the root's
-//! box test (which only culls).
+//! block test ([`SahCost::BLOCKS`]). A tree of one node (a scene whose primitives fit
+//! eight blocks) is queried without the traversal ([`small`]): one leaf by its block
+//! test alone, several by the root's box test and their blocks near to far.
 //!
 //! Triangles keep the watertight test (Woop et al. 2013) on the same vertex values as
 //! the meshes, so a hit's distance is the same bits as the mesh's own test gives. Each
@@ -28,6 +28,7 @@ mod indexed;
 mod lanes;
 mod layout;
 mod packet;
+mod small;
 mod sphere;
 
 use glam::Vec3;
@@ -38,6 +39,7 @@ use crate::bvh::{BoxTest, Bvh, Node8, QNode8, Ray8, SahCost, ScalarBoxes, WideBv
 use crate::geometry::{Aabb, Ray, TriangleHit, WatertightRay};
 use block::{Block, FILTERED, ID_MASK, LANES, SPHERE};
 use indexed::IndexedLeaves;
+use small::{SmallTree, SoleLeaf};
 
 pub use crate::bvh::Simd;
 pub use geometry::{Geometry, Located, TriangleMesh};
@@ -116,17 +118,8 @@ pub struct Accel {
     /// Whether every primitive is an unfiltered triangle: the AVX2 traversal then runs
     /// a copy whose block tests skip the check for spheres and filters.
     plain: bool,
-    /// The one leaf of a tree that is one node over one leaf ([`WideBvh::sole_leaf`]):
-    /// every primitive fits one block, which queries test straight away.
-    sole_leaf: Option<SoleLeaf>,
-}
-
-/// A leaf as a wide node's lane names it (its block, or its first record), and its
-/// primitive count.
-#[derive(Clone, Copy, Debug)]
-struct SoleLeaf {
-    leaf: u32,
-    count: u32,
+    /// A tree of one node, which queries walk without the traversal ([`SmallTree`]).
+    small: SmallTree,
 }
 
 impl Accel {
@@ -215,9 +208,7 @@ impl Accel {
             Leaves::Inline(blocks) => blocks.iter().all(Block::is_plain),
             Leaves::Indexed(x) => x.is_plain(),
         };
-        let sole_leaf = bvh
-            .sole_leaf()
-            .map(|(leaf, count)| SoleLeaf { leaf, count });
+        let small = SmallTree::of(&bvh, layout.nodes);
         let tree = match layout.nodes {
             NodeLayout::Full => Tree::Full(bvh),
             NodeLayout::Quantized => Tree::Quantized(bvh.quantize()),
@@ -227,7 +218,7 @@ impl Accel {
             leaves,
             simd,
             plain,
-            sole_leaf,
+            small,
         }
     }
 
@@ -249,6 +240,14 @@ impl Accel {
                 Leaves::Indexed(_) => LeafLayout::Indexed,
             },
         }
+    }
+
+    /// The same structure queried by the traversal even where the tree is one node
+    /// ([`SmallTree`]): for tests that the shortcut finds the traversal's hits.
+    #[doc(hidden)]
+    pub fn without_shortcut(mut self) -> Accel {
+        self.small = SmallTree::default();
+        self
     }
 
     /// Bytes of the wide BVH's nodes and of the leaves (blocks, or records and
@@ -279,15 +278,21 @@ impl Accel {
         t_max: f32,
         filter: impl Fn(u32, &TriangleHit) -> bool,
     ) -> Option<Hit> {
-        if let Some(sole) = &self.sole_leaf {
+        let hit = |h: block::LaneHit| Hit {
+            prim: h.id,
+            t: h.hit.t,
+            b1: h.hit.b1,
+            b2: h.hit.b2,
+        };
+        if let Some(sole) = &self.small.leaf {
             return self
-                .sole_hit::<false, _>(sole, ray, t_max, &filter)
-                .map(|h| Hit {
-                    prim: h.id,
-                    t: h.hit.t,
-                    b1: h.hit.b1,
-                    b2: h.hit.b2,
-                });
+                .small_hit::<SoleLeaf, false, _>(sole, ray, t_max, &filter)
+                .map(hit);
+        }
+        if let Some(root) = &self.small.root {
+            return self
+                .small_hit::<Node8, false, _>(root, ray, t_max, &filter)
+                .map(hit);
         }
         // The leaf layout first, so that each kernel's traversal is compiled once per
         // layout, and the indexed one out of line, so that what callers inline is the
@@ -320,9 +325,14 @@ impl Accel {
         t_max: f32,
         filter: impl Fn(u32, &TriangleHit) -> bool,
     ) -> bool {
-        if let Some(sole) = &self.sole_leaf {
+        if let Some(sole) = &self.small.leaf {
             return self
-                .sole_hit::<true, _>(sole, ray, t_max, &filter)
+                .small_hit::<SoleLeaf, true, _>(sole, ray, t_max, &filter)
+                .is_some();
+        }
+        if let Some(root) = &self.small.root {
+            return self
+                .small_hit::<Node8, true, _>(root, ray, t_max, &filter)
                 .is_some();
         }
         match &self.leaves {
@@ -440,70 +450,6 @@ impl Accel {
         F: Fn(u32, &TriangleHit) -> bool,
     {
         self.occluded_with::<K, LEAF, false, _>(leaves, ray, t_max, filter)
-    }
-
-    /// The query of a tree that is one node over one leaf: the block test of that leaf
-    /// alone, without the root's box test, which only culls (the block test is exact, so
-    /// the hits are the traversal's). Apart from the traversal, so that the traversal's
-    /// code is as it was for other trees (a check inside it cost the spot room 1–5
-    /// instructions a query, and an arm beside it changed its register use: +8 %). As
-    /// for the traversal, a dispatch inlined into the caller and one call: the AVX2 test
-    /// compiled for AVX2, the others out of line (an out-of-line dispatch cost 42
-    /// instructions a query). With `ANY`, any hit (see [`Block::intersect`]).
-    #[inline(always)]
-    fn sole_hit<const ANY: bool, F: Fn(u32, &TriangleHit) -> bool>(
-        &self,
-        sole: &SoleLeaf,
-        ray: &Ray,
-        t_max: f32,
-        filter: &F,
-    ) -> Option<block::LaneHit> {
-        match &self.leaves {
-            // SAFETY: `finish` checked that the CPU supports `self.simd`.
-            #[cfg(target_arch = "x86_64")]
-            Leaves::Inline(blocks) if self.simd == Simd::Avx2 => unsafe {
-                if self.plain {
-                    sole_avx2::<ANY, true, _, _>(&blocks[..], sole, ray, t_max, filter)
-                } else {
-                    sole_avx2::<ANY, false, _, _>(&blocks[..], sole, ray, t_max, filter)
-                }
-            },
-            Leaves::Inline(blocks) => {
-                self.sole_hit_other::<ANY, _, _>(&blocks[..], sole, ray, t_max, filter)
-            }
-            Leaves::Indexed(x) => self.sole_hit_other::<ANY, _, _>(x, sole, ray, t_max, filter),
-        }
-    }
-
-    /// [`Accel::sole_hit`] with every kernel on indexed leaves, and with the SSE and
-    /// scalar kernels on inline blocks.
-    #[inline(never)]
-    fn sole_hit_other<const ANY: bool, L: LeafBlocks + ?Sized, F: Fn(u32, &TriangleHit) -> bool>(
-        &self,
-        leaves: &L,
-        sole: &SoleLeaf,
-        ray: &Ray,
-        t_max: f32,
-        filter: &F,
-    ) -> Option<block::LaneHit> {
-        // SAFETY: `finish` checked that the CPU supports `self.simd`.
-        unsafe {
-            match self.simd {
-                #[cfg(target_arch = "x86_64")]
-                Simd::Avx2 if self.plain => {
-                    sole_avx2::<ANY, true, _, _>(leaves, sole, ray, t_max, filter)
-                }
-                #[cfg(target_arch = "x86_64")]
-                Simd::Avx2 => sole_avx2::<ANY, false, _, _>(leaves, sole, ray, t_max, filter),
-                #[cfg(target_arch = "x86_64")]
-                Simd::Sse => sole_block_hit::<{ block::SSE }, ANY, false, _>(
-                    leaves, sole, ray, t_max, filter,
-                ),
-                _ => sole_block_hit::<{ block::SCALAR }, ANY, false, _>(
-                    leaves, sole, ray, t_max, filter,
-                ),
-            }
-        }
     }
 
     /// The traversal compiled with AVX2 enabled, so that its box and triangle kernels
@@ -680,56 +626,6 @@ unsafe fn occluded_tree<
                 },
             )
         },
-    )
-}
-
-/// [`sole_block_hit`] compiled with AVX2 enabled, so that the block test inlines.
-///
-/// # Safety
-/// The CPU must support AVX2.
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2,bmi1,bmi2,lzcnt")]
-unsafe fn sole_avx2<const ANY: bool, const PLAIN: bool, L, F>(
-    leaves: &L,
-    sole: &SoleLeaf,
-    ray: &Ray,
-    t_max: f32,
-    filter: &F,
-) -> Option<block::LaneHit>
-where
-    L: LeafBlocks + ?Sized,
-    F: Fn(u32, &TriangleHit) -> bool,
-{
-    sole_block_hit::<{ block::AVX2 }, ANY, PLAIN, _>(leaves, sole, ray, t_max, filter)
-}
-
-/// The block test of a tree's one leaf (see [`Accel::sole_hit`]). Rays that are not
-/// finite find nothing, as in the traversal.
-///
-/// # Safety
-/// The CPU must support `LEAF`.
-#[inline(always)]
-unsafe fn sole_block_hit<const LEAF: u8, const ANY: bool, const PLAIN: bool, L>(
-    leaves: &L,
-    sole: &SoleLeaf,
-    ray: &Ray,
-    t_max: f32,
-    filter: &impl Fn(u32, &TriangleHit) -> bool,
-) -> Option<block::LaneHit>
-where
-    L: LeafBlocks + ?Sized,
-{
-    if !crate::bvh::finite(ray) {
-        return None;
-    }
-    // The same bits as the traversal's `from_recip` (the same division).
-    let wray = WatertightRay::new(ray);
-    let count = sole.count;
-    leaves.with_block(
-        sole.leaf,
-        count,
-        #[inline(always)]
-        |block| block.intersect::<LEAF, ANY, PLAIN>(ray, &wray, count, t_max, filter),
     )
 }
 

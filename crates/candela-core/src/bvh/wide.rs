@@ -315,6 +315,15 @@ impl<N: WideNode> WideBvh<N> {
         })
     }
 
+    /// The root when the tree is one node: every child is a leaf (there is no other node
+    /// to be an interior child), and a query needs no stack.
+    pub fn sole_node(&self) -> Option<&N> {
+        match &self.nodes[..] {
+            [root] => Some(root),
+            _ => None,
+        }
+    }
+
     /// Finds the nearest hit. `leaf(first, count, t_max)` tests the leaf's primitives
     /// and returns the distance of the nearest one hit before `t_max` (or `t_max`);
     /// `prefetch_leaf(first)` is called when a leaf is put off for later, so that the

@@ -1,0 +1,293 @@
+//! Queries of trees that are one node: a scene whose primitives fit eight leaves (a
+//! room, a Cornell box). They need none of the traversal's machinery (stack, pops,
+//! child ranks): one leaf is tested straight away, and one node over several leaves
+//! takes its box test, then its blocks near to far, each only while it is entered before
+//! the nearest hit so far. Each finds the traversal's hits, bit for bit: the same block
+//! tests with the same `t_max`, in the traversal's order.
+//!
+//! Apart from the traversal, so that its code is as it was for other trees (a check
+//! inside it cost the spot room 1–5 instructions a query, and an arm beside it changed
+//! its register use: +8 %). As for the traversal, a dispatch inlined into the caller
+//! and one call: the AVX2 query compiled for AVX2, the others out of line (an
+//! out-of-line dispatch cost 42 instructions a query).
+
+#[cfg(target_arch = "x86_64")]
+use crate::bvh::Avx2Boxes;
+#[cfg(target_arch = "x86_64")]
+use crate::bvh::SseBoxes;
+use crate::bvh::{BoxTest, Node8, Ray8, ScalarBoxes, Simd, WideBvh, T_MAX_SCALE};
+use crate::geometry::{Ray, TriangleHit, WatertightRay};
+
+use super::block::{self, LaneHit};
+use super::{Accel, LeafBlocks, Leaves, NodeLayout};
+
+/// A tree of one node, as its queries want it: at most one of the two is set. Two
+/// options checked one after the other, not one enum: the one-leaf query's dispatch
+/// stays one compare (an enum's cost the one-leaf scenes 9–11 instructions a path).
+#[derive(Clone, Debug, Default)]
+pub(super) struct SmallTree {
+    /// One leaf: its block test alone, without the root's box test, which only culls
+    /// (the block test is exact).
+    pub(super) leaf: Option<SoleLeaf>,
+    /// A root whose two to eight children are all leaves (a tree of one node has no
+    /// interior child). Boxed: the structure stays small for trees that are not one node.
+    pub(super) root: Option<Box<Node8>>,
+}
+
+/// A leaf as a wide node's lane names it (its block, or its first record), and its
+/// primitive count.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct SoleLeaf {
+    leaf: u32,
+    count: u32,
+}
+
+impl SmallTree {
+    /// What the queries of `bvh` (with its leaves already named as the leaf layout
+    /// names them) can shortcut, if anything. One node over several leaves only with
+    /// full-precision boxes: the quantized layout keeps the traversal, whose hits on
+    /// its wider boxes it would not reproduce bit for bit otherwise.
+    pub(super) fn of(bvh: &WideBvh<Node8>, nodes: NodeLayout) -> SmallTree {
+        if let Some((leaf, count)) = bvh.sole_leaf() {
+            return SmallTree {
+                leaf: Some(SoleLeaf { leaf, count }),
+                root: None,
+            };
+        }
+        SmallTree {
+            leaf: None,
+            root: match (bvh.sole_node(), nodes) {
+                (Some(root), NodeLayout::Full) => Some(Box::new(*root)),
+                _ => None,
+            },
+        }
+    }
+}
+
+impl Accel {
+    /// The query of a tree of one node `tree` ([`SmallTree`]); with `ANY`, any hit (see
+    /// [`super::Block::intersect`]). Each kind of tree has its own out-of-line query,
+    /// so that the one-leaf query keeps its lean frame.
+    #[inline(always)]
+    pub(super) fn small_hit<T: SmallQuery, const ANY: bool, F: Fn(u32, &TriangleHit) -> bool>(
+        &self,
+        tree: &T,
+        ray: &Ray,
+        t_max: f32,
+        filter: &F,
+    ) -> Option<LaneHit> {
+        match &self.leaves {
+            // SAFETY: `finish` checked that the CPU supports `self.simd`.
+            #[cfg(target_arch = "x86_64")]
+            Leaves::Inline(blocks) if self.simd == Simd::Avx2 => unsafe {
+                if self.plain {
+                    small_avx2::<T, ANY, true, _, _>(&blocks[..], tree, ray, t_max, filter)
+                } else {
+                    small_avx2::<T, ANY, false, _, _>(&blocks[..], tree, ray, t_max, filter)
+                }
+            },
+            Leaves::Inline(blocks) => {
+                self.small_hit_other::<T, ANY, _, _>(&blocks[..], tree, ray, t_max, filter)
+            }
+            Leaves::Indexed(x) => self.small_hit_other::<T, ANY, _, _>(x, tree, ray, t_max, filter),
+        }
+    }
+
+    /// [`Accel::small_hit`] with every kernel on indexed leaves, and with the SSE and
+    /// scalar kernels on inline blocks.
+    #[inline(never)]
+    fn small_hit_other<T: SmallQuery, const ANY: bool, L, F>(
+        &self,
+        leaves: &L,
+        tree: &T,
+        ray: &Ray,
+        t_max: f32,
+        filter: &F,
+    ) -> Option<LaneHit>
+    where
+        L: LeafBlocks + ?Sized,
+        F: Fn(u32, &TriangleHit) -> bool,
+    {
+        // SAFETY: `finish` checked that the CPU supports `self.simd`.
+        unsafe {
+            match self.simd {
+                #[cfg(target_arch = "x86_64")]
+                Simd::Avx2 if self.plain => {
+                    small_avx2::<T, ANY, true, _, _>(leaves, tree, ray, t_max, filter)
+                }
+                #[cfg(target_arch = "x86_64")]
+                Simd::Avx2 => small_avx2::<T, ANY, false, _, _>(leaves, tree, ray, t_max, filter),
+                #[cfg(target_arch = "x86_64")]
+                Simd::Sse => T::query::<SseBoxes, { block::SSE }, ANY, false, _>(
+                    tree, leaves, ray, t_max, filter,
+                ),
+                _ => T::query::<ScalarBoxes, { block::SCALAR }, ANY, false, _>(
+                    tree, leaves, ray, t_max, filter,
+                ),
+            }
+        }
+    }
+}
+
+/// [`SmallQuery::query`] compiled with AVX2 enabled, so that the box and block tests
+/// inline.
+///
+/// # Safety
+/// The CPU must support AVX2.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2,bmi1,bmi2,lzcnt")]
+unsafe fn small_avx2<T: SmallQuery, const ANY: bool, const PLAIN: bool, L, F>(
+    leaves: &L,
+    tree: &T,
+    ray: &Ray,
+    t_max: f32,
+    filter: &F,
+) -> Option<LaneHit>
+where
+    L: LeafBlocks + ?Sized,
+    F: Fn(u32, &TriangleHit) -> bool,
+{
+    T::query::<Avx2Boxes, { block::AVX2 }, ANY, PLAIN, _>(tree, leaves, ray, t_max, filter)
+}
+
+/// The query of one kind of small tree.
+pub(super) trait SmallQuery {
+    /// The nearest hit (with `ANY`, any hit) with box kernel `K` and block kernel
+    /// `LEAF`. Rays that are not finite find nothing, as in the traversal.
+    ///
+    /// # Safety
+    /// The CPU must support `K` and `LEAF`.
+    unsafe fn query<K: BoxTest, const LEAF: u8, const ANY: bool, const PLAIN: bool, L>(
+        &self,
+        leaves: &L,
+        ray: &Ray,
+        t_max: f32,
+        filter: &impl Fn(u32, &TriangleHit) -> bool,
+    ) -> Option<LaneHit>
+    where
+        L: LeafBlocks + ?Sized;
+}
+
+impl SmallQuery for SoleLeaf {
+    /// The block test of the one leaf.
+    #[inline(always)]
+    unsafe fn query<K: BoxTest, const LEAF: u8, const ANY: bool, const PLAIN: bool, L>(
+        &self,
+        leaves: &L,
+        ray: &Ray,
+        t_max: f32,
+        filter: &impl Fn(u32, &TriangleHit) -> bool,
+    ) -> Option<LaneHit>
+    where
+        L: LeafBlocks + ?Sized,
+    {
+        if !crate::bvh::finite(ray) {
+            return None;
+        }
+        // The same bits as the traversal's `from_recip` (the same division).
+        let wray = WatertightRay::new(ray);
+        let SoleLeaf { leaf, count } = *self;
+        leaves.with_block(
+            leaf,
+            count,
+            #[inline(always)]
+            |block| block.intersect::<LEAF, ANY, PLAIN>(ray, &wray, count, t_max, filter),
+        )
+    }
+}
+
+impl SmallQuery for Node8 {
+    #[inline(always)]
+    unsafe fn query<K: BoxTest, const LEAF: u8, const ANY: bool, const PLAIN: bool, L>(
+        &self,
+        leaves: &L,
+        ray: &Ray,
+        t_max: f32,
+        filter: &impl Fn(u32, &TriangleHit) -> bool,
+    ) -> Option<LaneHit>
+    where
+        L: LeafBlocks + ?Sized,
+    {
+        root_query::<K, LEAF, ANY, PLAIN, _>(leaves, self, ray, t_max, filter)
+    }
+}
+
+/// One node over leaves: its box test, then the blocks of the children entered. A
+/// closest-hit query tests them nearest entry first (the higher lane first among equal
+/// entries), and stops at the first entered beyond the nearest hit so far (widened by
+/// [`T_MAX_SCALE`]): the order and the cut of [`WideBvh::intersect`], whose pops skip
+/// every farther one too. An any-hit query tests them in lane order, as
+/// [`WideBvh::occluded`] does.
+///
+/// # Safety
+/// The CPU must support `K` and `LEAF`.
+#[inline(always)]
+unsafe fn root_query<K: BoxTest, const LEAF: u8, const ANY: bool, const PLAIN: bool, L>(
+    leaves: &L,
+    root: &Node8,
+    ray: &Ray,
+    t_max: f32,
+    filter: &impl Fn(u32, &TriangleHit) -> bool,
+) -> Option<LaneHit>
+where
+    L: LeafBlocks + ?Sized,
+{
+    let r8 = Ray8::new(ray);
+    if !r8.finite {
+        return None;
+    }
+    let wray = WatertightRay::from_recip(ray, r8.inv_d);
+    let r = K::prepare(&r8);
+    let mut t_box = t_max * T_MAX_SCALE;
+    let (mut mask, t_near) = K::hit8(&r, &root.planes, t_box);
+    let mut t_max = t_max;
+    let mut best = None;
+    while mask != 0 {
+        let lane = if ANY {
+            mask.trailing_zeros() as usize
+        } else {
+            let lane = nearest(mask, &t_near);
+            if t_near[lane] > t_box {
+                break;
+            }
+            lane
+        };
+        mask &= !(1 << lane);
+        let count = root.count[lane] as u32;
+        // Opaque, as in the traversal: the block test's broadcasts are made where a
+        // block is tested, not hoisted into the set-up and spilled.
+        let (ray, wray) = std::hint::black_box((ray, &wray));
+        let hit = leaves.with_block(
+            root.child[lane],
+            count,
+            #[inline(always)]
+            |block| block.intersect::<LEAF, ANY, PLAIN>(ray, wray, count, t_max, filter),
+        );
+        if let Some(h) = hit {
+            if ANY {
+                return Some(h);
+            }
+            t_max = h.hit.t;
+            t_box = t_max * T_MAX_SCALE;
+            best = Some(h);
+        }
+    }
+    best
+}
+
+/// The lane of `mask` with the least `t` (never NaN: the box test's entry distances),
+/// the highest among equals.
+#[inline(always)]
+fn nearest(mask: u32, t: &[f32; 8]) -> usize {
+    let mut rest = mask;
+    let mut best = rest.trailing_zeros() as usize;
+    rest &= rest - 1;
+    while rest != 0 {
+        let lane = rest.trailing_zeros() as usize;
+        rest &= rest - 1;
+        if t[lane] <= t[best] {
+            best = lane;
+        }
+    }
+    best
+}
