@@ -127,6 +127,8 @@ def main():
     ap.add_argument("--scenes", default="cornell,glass_sphere,plastics",
                     help="comma-separated names of the scenes to run, in order: "
                          + ", ".join(name_of(scene) for scene, _ in SCENES))
+    ap.add_argument("--seed", type=int, default=2,
+                    help="seed of every image but the reference (seed 1)")
     ap.add_argument("--samplers", default="",
                     help="comma-separated --sampler values to run each variant with (default: "
                          "the renderer's default only); adds the low-frequency error columns")
@@ -166,8 +168,8 @@ def main():
             print(f"{name}: reference {a.ref_spp} spp in {t:.1f} s", flush=True)
         ref = read_pfm(ref_path)
         for label, spp, extra in variants:
-            out = os.path.join(a.out, f"{tag}-{spp}-{'-'.join(extra) or 'raw'}.pfm")
-            t = render(a.binary, scene, out, res, spp, 2, a.threads, extra)
+            out = os.path.join(a.out, f"{tag}-{spp}-{'-'.join(extra) or 'raw'}-s{a.seed}.pfm")
+            t = render(a.binary, scene, out, res, spp, a.seed, a.threads, extra)
             x = read_pfm(out)
             assert np.isfinite(x).all(), out
             plain = float(per_pixel_relmse(x, ref).mean())
