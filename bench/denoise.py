@@ -8,6 +8,11 @@ Errors: relMSE with the worst 1 % of pixels dropped (per-pixel relMSE, mean over
 channels, ε = 1e-2; a denoiser rightly softens the edges of directly seen lamps, which
 plain relMSE punishes out of all proportion; plain relMSE is printed too) and HDR-FLIP
 (`flip-evaluator` from PyPI, its default exposure range and 67 pixels per degree).
+Low-frequency error (--samplers runs): "binned relMSE" is the relMSE of the images
+averaged over 4×4 pixel bins (the error a viewer sees from afar: white noise loses 16× of
+its power to the binning, blue noise more), and "LF power" the mean power of the
+luminance error's spectrum below 1/8 cycle per pixel over its mean at all frequencies
+(about 1 for white noise, below 1 for blue).
 Times are candela's own: the path tracer, plus the AOV pass and the denoiser where they
 ran (loading, building and writing excluded), on all the machine's cores (or --threads).
 Scenes render at their own resolution (--scale for a fraction of it); references are
@@ -85,6 +90,26 @@ def flip_hdr(x, ref):
     return float(mean), params
 
 
+def binned_relmse(x, ref, b=4):
+    """relMSE of the images averaged over b×b bins (the edges that do not fill a bin cut)."""
+    h, w = (ref.shape[0] // b) * b, (ref.shape[1] // b) * b
+    def bin_(img):
+        return img[:h, :w].reshape(h // b, b, w // b, b, -1).mean(axis=(1, 3))
+    return float(per_pixel_relmse(bin_(x), bin_(ref)).mean())
+
+
+def low_frequency_power(x, ref, cutoff=0.125):
+    """Mean power of the luminance error's spectrum at 0 < |f| <= cutoff (cycles per pixel)
+    over its mean at every frequency but 0: about 1 for white noise."""
+    w = np.array([0.2126, 0.7152, 0.0722])
+    e = (x - ref) @ w
+    power = np.abs(np.fft.fft2(e)) ** 2
+    fy = np.fft.fftfreq(e.shape[0])[:, None]
+    fx = np.fft.fftfreq(e.shape[1])[None, :]
+    f = np.sqrt(fx ** 2 + fy ** 2)
+    return float(power[(f > 0) & (f <= cutoff)].mean() / power[f > 0].mean())
+
+
 def name_of(scene):
     """scenes/cornell.toml -> cornell."""
     return os.path.splitext(os.path.basename(scene))[0]
@@ -102,18 +127,35 @@ def main():
     ap.add_argument("--scenes", default="cornell,glass_sphere,plastics",
                     help="comma-separated names of the scenes to run, in order: "
                          + ", ".join(name_of(scene) for scene, _ in SCENES))
+    ap.add_argument("--seed", type=int, default=2,
+                    help="seed of every image but the reference (seed 1)")
+    ap.add_argument("--samplers", default="",
+                    help="comma-separated --sampler values to run each variant with (default: "
+                         "the renderer's default only); adds the low-frequency error columns")
+    ap.add_argument("--variants", default="raw16,raw256,denoised16,color16,denoised64",
+                    help="which images to make, of raw16, raw256, denoised16 (albedo + "
+                         "normal), color16 (beauty alone), denoised64")
     a = ap.parse_args()
     os.makedirs(a.out, exist_ok=True)
     info = machine.describe(REPO)
     print(f"{info['date']}, {info['git']}, {info['cpu']} ({info['nproc']} threads), "
           f"load before {machine.loadavg()}", flush=True)
-    variants = [
-        ("raw", 16, ()),
-        ("raw", 256, ()),
-        ("denoised, albedo + normal", 16, ("--denoise",)),
-        ("denoised, beauty alone", 16, ("--denoise=color",)),
-        ("denoised, albedo + normal", 64, ("--denoise",)),
-    ]
+    known = {
+        "raw16": ("raw", 16, ()),
+        "raw256": ("raw", 256, ()),
+        "denoised16": ("denoised, albedo + normal", 16, ("--denoise",)),
+        "color16": ("denoised, beauty alone", 16, ("--denoise=color",)),
+        "denoised64": ("denoised, albedo + normal", 64, ("--denoise",)),
+    }
+    samplers = [x for x in a.samplers.split(",") if x] or [None]
+    variants = []
+    for sampler in samplers:
+        for v in a.variants.split(","):
+            label, spp, extra = known[v]
+            if sampler:
+                label, extra = f"{sampler}, {label}", (*extra, "--sampler", sampler)
+            variants.append((label, spp, extra))
+    spectral = bool(a.samplers)
     rows = []
     scenes = {name_of(scene): (scene, own) for scene, own in SCENES}
     for name in a.scenes.split(","):
@@ -126,22 +168,27 @@ def main():
             print(f"{name}: reference {a.ref_spp} spp in {t:.1f} s", flush=True)
         ref = read_pfm(ref_path)
         for label, spp, extra in variants:
-            out = os.path.join(a.out, f"{tag}-{spp}-{'-'.join(extra) or 'raw'}.pfm")
-            t = render(a.binary, scene, out, res, spp, 2, a.threads, extra)
+            out = os.path.join(a.out, f"{tag}-{spp}-{'-'.join(extra) or 'raw'}-s{a.seed}.pfm")
+            t = render(a.binary, scene, out, res, spp, a.seed, a.threads, extra)
             x = read_pfm(out)
             assert np.isfinite(x).all(), out
             plain = float(per_pixel_relmse(x, ref).mean())
             flip_mean, params = flip_hdr(x, ref)
             row = [f"{name} {res[0]}×{res[1]}", label, spp, f"{t:.2f}",
                    f"{relmse_dropped(x, ref):.5f}", f"{plain:.5f}", f"{flip_mean:.4f}"]
+            if spectral:
+                row += [f"{binned_relmse(x, ref):.6f}", f"{low_frequency_power(x, ref):.3f}"]
             print(" | ".join(map(str, row)), flush=True)
             rows.append(row)
         print(f"{name}: HDR-FLIP exposures {params['startExposure']:.2f} to "
               f"{params['stopExposure']:.2f} in {params['numExposures']} steps, "
               f"{params['ppd']:.1f} ppd, {params['tonemapper']}", flush=True)
     print(f"load after {machine.loadavg()}\n")
-    print(report.table(["scene", "image", "spp", "time (s)", "relMSE, worst 1 % dropped",
-                        "relMSE", "HDR-FLIP"], rows, "llrrrrr"))
+    header = ["scene", "image", "spp", "time (s)", "relMSE, worst 1 % dropped", "relMSE",
+              "HDR-FLIP"]
+    if spectral:
+        header += ["binned relMSE (4×4)", "LF power"]
+    print(report.table(header, rows, "ll" + "r" * (len(header) - 2)))
 
 
 if __name__ == "__main__":

@@ -123,8 +123,10 @@ pub struct RenderArgs {
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..))]
     ris_candidates: Option<u32>,
     /// Sample generator: independent (uniform random numbers), sobol (Owen-scrambled
-    /// Sobol' points, stratified within each pixel) or sobol-cmj (the default: sobol, but
-    /// the first bounce's BSDF direction from a correlated multi-jittered pattern).
+    /// Sobol' points, stratified within each pixel), sobol-cmj (the default: sobol, but
+    /// the first bounce's BSDF direction from a correlated multi-jittered pattern) or
+    /// zsobol (one Sobol' sequence over the image in scrambled Morton order: the error is
+    /// blue noise in screen space, which suits --denoise).
     #[arg(long, value_parser = parse_name::<SamplerKind>)]
     sampler: Option<SamplerKind>,
     /// How a pixel filter wider than a pixel (a Mitsuba scene's tent or Gaussian) reaches

@@ -63,12 +63,18 @@ fn same_seed_gives_the_same_image_whatever_the_thread_count() {
     let c = render("c.pfm", &["--threads", "2", "--seed", "4"]);
     assert_eq!(a, b, "thread count changed the image");
     assert_ne!(a, c, "the seed did not change the image");
-    // The default sampler is sobol-cmj; the independent one is as deterministic.
+    // The default sampler is sobol-cmj; the independent and zsobol ones are as
+    // deterministic.
     let independent = ["--sampler", "independent", "--seed", "3"];
     let d = render("d.pfm", &[&["--threads", "1"][..], &independent].concat());
     let e = render("e.pfm", &[&["--threads", "2"][..], &independent].concat());
     assert_eq!(d, e, "thread count changed the independent sampler's image");
     assert_ne!(a, d, "--sampler independent did not change the image");
+    let zsobol = ["--sampler", "zsobol", "--seed", "3"];
+    let g = render("g.pfm", &[&["--threads", "1"][..], &zsobol].concat());
+    let h = render("h.pfm", &[&["--threads", "2"][..], &zsobol].concat());
+    assert_eq!(g, h, "thread count changed the zsobol sampler's image");
+    assert_ne!(a, g, "--sampler zsobol did not change the image");
     assert_eq!(
         a,
         render("f.pfm", &["--sampler", "sobol-cmj", "--seed", "3"])

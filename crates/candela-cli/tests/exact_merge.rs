@@ -73,6 +73,7 @@ fn every_split_merges_to_the_single_render_bit_for_bit() {
         SamplerKind::Independent,
         SamplerKind::Sobol,
         SamplerKind::SobolCmj,
+        SamplerKind::Zsobol,
     ];
     for filter in filters {
         for sampler in samplers {

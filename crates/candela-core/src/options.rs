@@ -87,7 +87,7 @@ pub enum LampSampling {
 }
 
 /// Where the integrator's uniform numbers come from (see [`crate::sampler`]). Its names in
-/// scene files and on the command line are `independent`, `sobol` and `sobol-cmj`.
+/// scene files and on the command line are `independent`, `sobol`, `sobol-cmj` and `zsobol`.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum SamplerKind {
@@ -106,6 +106,12 @@ pub enum SamplerKind {
     /// (bench/RESULTS.md, sampler).
     #[default]
     SobolCmj,
+    /// One Owen-scrambled Sobol' sequence over the whole image in a scrambled Morton order
+    /// of the pixels ([`crate::sampler::ZSobolSampler`], pbrt-v4's `ZSobolSampler`): each
+    /// pixel as stratified as with [`SamplerKind::Sobol`], and neighbouring pixels
+    /// stratified together, so the error is blue noise in screen space (what HDR-FLIP
+    /// and a denoiser forgive most).
+    Zsobol,
 }
 
 /// Which compiled copy of the render loop runs (see [`crate::isa`]). Its names on the

@@ -15,30 +15,9 @@
 
 use candela_core::sampler::{IndependentSampler, SobolSampler};
 use candela_test_support::samplers::{
-    chi2_over_pixels, draw, points, two_requests_are_independent, Request,
+    chi2_over_pixels, draw, is_stratified, points, two_requests_are_independent, Request,
 };
 use glam::{UVec2, Vec2};
-
-/// Whether the points are a (0, k, 2)-net (2D) or a one-per-stratum set (1D), k = log2 n.
-fn is_stratified(points: &[Vec2], two_d: bool) -> bool {
-    let n = points.len();
-    assert!(n.is_power_of_two());
-    let k = n.trailing_zeros();
-    let splits: Vec<(u32, u32)> = if two_d {
-        (0..=k).map(|a| (a, k - a)).collect()
-    } else {
-        vec![(k, 0)]
-    };
-    splits.into_iter().all(|(a, b)| {
-        let mut seen = vec![false; n];
-        points.iter().all(|p| {
-            let ix = (p.x as f64 * (1u64 << a) as f64) as usize;
-            let iy = (p.y as f64 * (1u64 << b) as f64) as usize;
-            let cell = (iy << a) | ix;
-            !std::mem::replace(&mut seen[cell], true)
-        })
-    })
-}
 
 const REQUESTS: [Request; 6] = [
     Request::TwoD { skip: 0 },

@@ -113,6 +113,7 @@ fn lanes_match_with_every_sampler_and_mis_mode() {
             SamplerKind::Independent,
             SamplerKind::Sobol,
             SamplerKind::SobolCmj,
+            SamplerKind::Zsobol,
         ] {
             for mis in [
                 MisMode::Balance,

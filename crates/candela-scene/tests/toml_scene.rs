@@ -79,6 +79,7 @@ fn render_settings_and_camera() {
         ("independent", SamplerKind::Independent),
         ("sobol", SamplerKind::Sobol),
         ("sobol-cmj", SamplerKind::SobolCmj),
+        ("zsobol", SamplerKind::Zsobol),
     ] {
         let r = parse(&format!("[render]\nsampler = \"{name}\"")).render;
         assert_eq!(r.sampler, kind);
@@ -86,7 +87,7 @@ fn render_settings_and_camera() {
     let bad = parse_toml_scene("[render]\nsampler = \"halton\"\n", Path::new("scene.toml"));
     assert_eq!(
         bad.unwrap_err().to_string(),
-        "scene.toml:2:11: unknown variant `halton`, expected one of `independent`, `sobol`, `sobol-cmj`"
+        "scene.toml:2:11: unknown variant `halton`, expected one of `independent`, `sobol`, `sobol-cmj`, `zsobol`"
     );
     // Defaults when the sections are absent.
     let d = parse("");

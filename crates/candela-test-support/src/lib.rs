@@ -8,6 +8,7 @@
 //! - [`tiles`]: two estimators' renders compared tile by tile with Welch's t-test;
 //! - [`samplers`]: drawing a sampler's requests and testing their distribution and
 //!   stratification;
+//! - [`spectrum`]: how blue an image's error is (its radially split power spectrum);
 //! - [`assert_close`].
 //!
 //! The statistics themselves (chi-square, Welch) live in `candela_core::chi2`, which the
@@ -17,6 +18,7 @@ pub mod files;
 pub mod gltf;
 pub mod mitsuba;
 pub mod samplers;
+pub mod spectrum;
 pub mod tiles;
 
 use glam::Vec3;

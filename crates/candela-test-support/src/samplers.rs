@@ -109,3 +109,24 @@ pub fn strata(n: u32, req: Request) -> Vec<(u32, u32)> {
         }
     }
 }
+
+/// Whether the points are a (0, k, 2)-net (2D) or a one-per-stratum set (1D), k = log2 n.
+pub fn is_stratified(points: &[Vec2], two_d: bool) -> bool {
+    let n = points.len();
+    assert!(n.is_power_of_two());
+    let k = n.trailing_zeros();
+    let splits: Vec<(u32, u32)> = if two_d {
+        (0..=k).map(|a| (a, k - a)).collect()
+    } else {
+        vec![(k, 0)]
+    };
+    splits.into_iter().all(|(a, b)| {
+        let mut seen = vec![false; n];
+        points.iter().all(|p| {
+            let ix = (p.x as f64 * (1u64 << a) as f64) as usize;
+            let iy = (p.y as f64 * (1u64 << b) as f64) as usize;
+            let cell = (iy << a) | ix;
+            !std::mem::replace(&mut seen[cell], true)
+        })
+    })
+}

@@ -11,7 +11,7 @@
 //! half a half's error).
 //!
 //! Samplers (`--samplers`, comma-separated; the first is what the ratios divide by):
-//! `independent`, `sobol` and `sobol-cmj` (the renderer's; `sobol-cmj` is `sobol` with the
+//! `independent`, `sobol`, `sobol-cmj` and `zsobol` (the renderer's; `sobol-cmj` is `sobol` with the
 //! first bounce's BSDF direction from a CMJ pattern, the default), `cmj` (padded correlated
 //! multi-jittered points for every request), `owen` (`sobol`'s
 //! construction with true nested uniform scrambles: every bit flipped by an independent
@@ -34,6 +34,7 @@ use candela_core::desc::SceneDesc;
 use candela_core::integrator::render_with;
 use candela_core::sampler::{
     mix64, sobol_2d, CmjSampler, IndependentSampler, Sampler, SobolCmjSampler, SobolSampler,
+    ZSobolSampler,
 };
 use glam::{UVec2, Vec2, Vec3};
 
@@ -89,7 +90,7 @@ fn parse_args() -> Result<Args, String> {
         );
     }
     for s in &a.samplers {
-        AnySampler::parse(s, 0, 1, false)?;
+        AnySampler::parse(s, 0, 1, false, UVec2::ONE)?;
     }
     Ok(a)
 }
@@ -174,6 +175,7 @@ enum AnySampler {
     Independent(IndependentSampler),
     Sobol(SobolSampler),
     SobolCmj(SobolCmjSampler),
+    ZSobol(ZSobolSampler),
     Cmj(CmjSampler),
     Owen(OwenSobol),
     /// `base` for every request except those starting at a dimension in `dims`.
@@ -193,7 +195,14 @@ enum Deferred {
 }
 
 impl AnySampler {
-    fn parse(name: &str, seed: u64, spp: u32, lens: bool) -> Result<AnySampler, String> {
+    /// `res`: the image's size, which `zsobol` orders its pixels in.
+    fn parse(
+        name: &str,
+        seed: u64,
+        spp: u32,
+        lens: bool,
+        res: UVec2,
+    ) -> Result<AnySampler, String> {
         if let Some((pair, dims)) = name.split_once('@') {
             let (base, other) = pair
                 .split_once('+')
@@ -203,8 +212,8 @@ impl AnySampler {
                 .map(|d| d.parse().map_err(|e| format!("{name}: {e}")))
                 .collect::<Result<_, _>>()?;
             return Ok(AnySampler::Hybrid {
-                base: Box::new(Self::parse(base, seed, spp, lens)?),
-                other: Box::new(Self::parse(other, seed ^ 0xabcd_ef01, spp, lens)?),
+                base: Box::new(Self::parse(base, seed, spp, lens, res)?),
+                other: Box::new(Self::parse(other, seed ^ 0xabcd_ef01, spp, lens, res)?),
                 dims,
                 dimension: 0,
             });
@@ -214,6 +223,7 @@ impl AnySampler {
             "sobol" => AnySampler::Sobol(SobolSampler::new(seed)),
             "sobol-cmj" => AnySampler::SobolCmj(SobolCmjSampler::new(seed, spp, lens)),
             "cmj" => AnySampler::Cmj(CmjSampler::new(seed, spp)),
+            "zsobol" => AnySampler::ZSobol(ZSobolSampler::new(seed, spp, res.x, res.y)),
             "owen" => AnySampler::Owen(OwenSobol {
                 seed,
                 pixel_key: 0,
@@ -249,6 +259,7 @@ impl Sampler for AnySampler {
             AnySampler::Independent(s) => s.start_pixel_sample(pixel, index),
             AnySampler::Sobol(s) => s.start_pixel_sample(pixel, index),
             AnySampler::SobolCmj(s) => s.start_pixel_sample(pixel, index),
+            AnySampler::ZSobol(s) => s.start_pixel_sample(pixel, index),
             AnySampler::Cmj(s) => s.start_pixel_sample(pixel, index),
             AnySampler::Owen(s) => s.start_pixel_sample(pixel, index),
             AnySampler::Hybrid {
@@ -273,6 +284,7 @@ impl Sampler for AnySampler {
             AnySampler::Independent(s) => s.get_1d(),
             AnySampler::Sobol(s) => s.get_1d(),
             AnySampler::SobolCmj(s) => s.get_1d(),
+            AnySampler::ZSobol(s) => s.get_1d(),
             AnySampler::Cmj(s) => s.get_1d(),
             AnySampler::Owen(s) => s.get_1d(),
             AnySampler::Hybrid { .. } => unreachable!(),
@@ -289,6 +301,7 @@ impl Sampler for AnySampler {
             AnySampler::Independent(s) => s.get_2d(),
             AnySampler::Sobol(s) => s.get_2d(),
             AnySampler::SobolCmj(s) => s.get_2d(),
+            AnySampler::ZSobol(s) => s.get_2d(),
             AnySampler::Cmj(s) => s.get_2d(),
             AnySampler::Owen(s) => s.get_2d(),
             AnySampler::Hybrid { .. } => unreachable!(),
@@ -310,6 +323,7 @@ impl Sampler for AnySampler {
             AnySampler::Independent(s) => Deferred::Value(s.defer_1d()),
             AnySampler::Sobol(s) => Deferred::Dimension(s.defer_1d()),
             AnySampler::SobolCmj(s) => Deferred::Dimension(s.defer_1d()),
+            AnySampler::ZSobol(s) => Deferred::Dimension(s.defer_1d()),
             AnySampler::Cmj(s) => Deferred::Dimension(s.defer_1d()),
             AnySampler::Owen(s) => Deferred::Dimension(s.defer_1d()),
             AnySampler::Hybrid { .. } => unreachable!(),
@@ -320,6 +334,7 @@ impl Sampler for AnySampler {
             (_, Deferred::Value(v)) => v,
             (AnySampler::Sobol(s), Deferred::Dimension(d)) => s.resolve_1d(d),
             (AnySampler::SobolCmj(s), Deferred::Dimension(d)) => s.resolve_1d(d),
+            (AnySampler::ZSobol(s), Deferred::Dimension(d)) => s.resolve_1d(d),
             (AnySampler::Cmj(s), Deferred::Dimension(d)) => s.resolve_1d(d),
             (AnySampler::Owen(s), Deferred::Dimension(d)) => s.resolve_1d(d),
             (AnySampler::Hybrid { base, other, .. }, Deferred::Pair(d, o)) => {
@@ -343,7 +358,8 @@ fn image(
     desc.render.spp = range.len() as u32;
     let scene = candela_core::build::build(&desc).expect("scene builds");
     let lens = scene.camera.needs_lens_sample();
-    let s = AnySampler::parse(sampler, seed, range.len() as u32, lens).expect("checked");
+    let res = UVec2::new(desc.render.width, desc.render.height);
+    let s = AnySampler::parse(sampler, seed, range.len() as u32, lens, res).expect("checked");
     let t = Instant::now();
     let r = render_with(&scene, s, range, &AtomicBool::new(false), &|_| {});
     (r.film.resolve(), t.elapsed().as_secs_f64())

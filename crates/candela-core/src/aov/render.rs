@@ -9,7 +9,7 @@ use rayon::prelude::*;
 use super::{first_surface, AovFilm, AovPixel};
 use crate::integrator::camera_ray;
 use crate::options::SamplerKind;
-use crate::sampler::{IndependentSampler, Sampler, SobolCmjSampler, SobolSampler};
+use crate::sampler::{IndependentSampler, Sampler, SobolCmjSampler, SobolSampler, ZSobolSampler};
 use crate::scene::Scene;
 
 /// Rows per parallel work item.
@@ -30,6 +30,11 @@ pub fn render_aovs(scene: &Scene, samples: Range<u32>, cancel: &AtomicBool) -> A
         SamplerKind::SobolCmj => {
             let s =
                 SobolCmjSampler::new(seed, scene.settings.spp, scene.camera.needs_lens_sample());
+            render_with(scene, s, samples, cancel)
+        }
+        SamplerKind::Zsobol => {
+            let settings = &scene.settings;
+            let s = ZSobolSampler::new(seed, settings.spp, settings.width, settings.height);
             render_with(scene, s, samples, cancel)
         }
     }

@@ -20,7 +20,7 @@ use std::sync::atomic::AtomicBool;
 
 use crate::film::Film;
 use crate::options::SamplerKind;
-use crate::sampler::{IndependentSampler, SobolCmjSampler, SobolSampler};
+use crate::sampler::{IndependentSampler, SobolCmjSampler, SobolSampler, ZSobolSampler};
 use crate::scene::Scene;
 
 mod band;
@@ -92,6 +92,11 @@ pub fn render(
         SamplerKind::SobolCmj => {
             let s =
                 SobolCmjSampler::new(seed, scene.settings.spp, scene.camera.needs_lens_sample());
+            render_with(scene, s, samples, cancel, progress)
+        }
+        SamplerKind::Zsobol => {
+            let settings = &scene.settings;
+            let s = ZSobolSampler::new(seed, settings.spp, settings.width, settings.height);
             render_with(scene, s, samples, cancel, progress)
         }
     }

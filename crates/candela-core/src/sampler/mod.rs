@@ -7,8 +7,11 @@
 //! dimensions in a fixed order: light pick (1D), light point (2D), BSDF lobe (1D), BSDF
 //! direction (2D), Russian roulette (1D). A low-discrepancy sampler can rely on that order.
 //!
-//! Four samplers: [`IndependentSampler`] (uniform random numbers), [`SobolSampler`]
-//! (Owen-scrambled Sobol' points, stratified within each pixel), [`SobolCmjSampler`]
+//! Five samplers: [`IndependentSampler`] (uniform random numbers), [`SobolSampler`]
+//! (Owen-scrambled Sobol' points, stratified within each pixel), [`ZSobolSampler`] (one
+//! Sobol' sequence for the whole image in a scrambled Morton order of the pixels, so that
+//! neighbouring pixels are stratified together and the error is blue noise),
+//! [`SobolCmjSampler`]
 //! (the Sobol' sampler's numbers except for the first bounce's BSDF direction, which a
 //! correlated multi-jittered pattern gives; that request sits at
 //! [`first_direction_dimension`] in the order above) and [`CmjSampler`] (correlated
@@ -26,12 +29,14 @@ mod cmj;
 mod pcg_lanes;
 mod sobol;
 mod sobol_cmj;
+mod zsobol;
 
 use glam::{UVec2, Vec2};
 
 pub use cmj::CmjSampler;
 pub use sobol::{owen_scramble, sobol_2d, SobolSampler};
 pub use sobol_cmj::{first_direction_dimension, SobolCmjSampler};
+pub use zsobol::ZSobolSampler;
 
 /// Streams a batched draw serves at once ([`Sampler::draw_bounce_lanes`]): the lanes
 /// integrator's paths in flight.

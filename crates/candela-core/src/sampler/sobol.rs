@@ -129,7 +129,7 @@ fn scramble_premixed(mut v: u32, seed: u32) -> u32 {
 
 /// The top 24 bits of a fraction as a float in [0, 1), exactly.
 #[inline]
-fn to_unit(v: u32) -> f32 {
+pub(super) fn to_unit(v: u32) -> f32 {
     (v >> 8) as f32 * (1.0 / (1u32 << 24) as f32)
 }
 
