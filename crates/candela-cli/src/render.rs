@@ -126,7 +126,7 @@ pub struct RenderArgs {
     /// Sobol' points, stratified within each pixel), sobol-cmj (the default: sobol, but
     /// the first bounce's BSDF direction from a correlated multi-jittered pattern) or
     /// zsobol (one Sobol' sequence over the image in scrambled Morton order: the error is
-    /// blue noise in screen space, which suits --denoise).
+    /// blue noise in screen space, fine-grained at low spp; ≈ 40 % more instructions).
     #[arg(long, value_parser = parse_name::<SamplerKind>)]
     sampler: Option<SamplerKind>,
     /// How a pixel filter wider than a pixel (a Mitsuba scene's tent or Gaussian) reaches

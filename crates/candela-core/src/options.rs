@@ -109,8 +109,9 @@ pub enum SamplerKind {
     /// One Owen-scrambled Sobol' sequence over the whole image in a scrambled Morton order
     /// of the pixels ([`crate::sampler::ZSobolSampler`], pbrt-v4's `ZSobolSampler`): each
     /// pixel as stratified as with [`SamplerKind::Sobol`], and neighbouring pixels
-    /// stratified together, so the error is blue noise in screen space (what HDR-FLIP
-    /// and a denoiser forgive most).
+    /// stratified together, so the error is blue noise in screen space: fine-grained
+    /// rather than blotchy at low spp (bench/RESULTS.md, denoise: it did not lower
+    /// HDR-FLIP after denoising).
     Zsobol,
 }
 

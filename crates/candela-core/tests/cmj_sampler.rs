@@ -17,17 +17,9 @@
 use candela_core::sampler::{CmjSampler, IndependentSampler, Sampler};
 use candela_test_support::samplers::{
     chi2_over_pixels, draw, one_per_cell, points, strata, two_requests_are_independent, Request,
+    REQUESTS,
 };
 use glam::{UVec2, Vec2};
-
-const REQUESTS: [Request; 6] = [
-    Request::TwoD { skip: 0 },
-    Request::OneD { skip: 0 },
-    Request::TwoD { skip: 1 },
-    Request::OneD { skip: 3 },
-    Request::TwoD { skip: 7 },
-    Request::TwoD { skip: 40 },
-];
 
 #[test]
 fn every_request_of_a_pixel_is_stratified() {

@@ -14,19 +14,10 @@
 use candela_core::chi2::{sidak_alpha, ChiSquareTest};
 use candela_core::sampler::{Sampler, SobolSampler, ZSobolSampler};
 use candela_test_support::samplers::{
-    chi2_over_pixels, draw, is_stratified, points, two_requests_are_independent, Request,
+    chi2_over_pixels, draw, is_stratified, points, two_requests_are_independent, Request, REQUESTS,
 };
 use candela_test_support::spectrum::low_frequency_power_ratio;
 use glam::{UVec2, Vec2};
-
-const REQUESTS: [Request; 6] = [
-    Request::TwoD { skip: 0 },
-    Request::OneD { skip: 0 },
-    Request::TwoD { skip: 1 },
-    Request::OneD { skip: 3 },
-    Request::TwoD { skip: 7 },
-    Request::TwoD { skip: 40 },
-];
 
 #[test]
 fn each_pixels_samples_are_stratified() {

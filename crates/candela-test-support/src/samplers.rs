@@ -12,6 +12,17 @@ pub enum Request {
     TwoD { skip: u32 },
 }
 
+/// Requests the sampler tests check: the first 1D and 2D ones, a few after them, and one
+/// far beyond the dimensions a Sobol' table holds (where samplers pad by hashing).
+pub const REQUESTS: [Request; 6] = [
+    Request::TwoD { skip: 0 },
+    Request::OneD { skip: 0 },
+    Request::TwoD { skip: 1 },
+    Request::OneD { skip: 3 },
+    Request::TwoD { skip: 7 },
+    Request::TwoD { skip: 40 },
+];
+
 /// The numbers of request `req` of sample `index` of `pixel` (a 1D request in x, y zero).
 pub fn draw<S: Sampler>(s: &mut S, pixel: UVec2, index: u32, req: Request) -> Vec2 {
     s.start_pixel_sample(pixel, index);

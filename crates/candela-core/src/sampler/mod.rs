@@ -11,9 +11,8 @@
 //! (Owen-scrambled Sobol' points, stratified within each pixel), [`ZSobolSampler`] (one
 //! Sobol' sequence for the whole image in a scrambled Morton order of the pixels, so that
 //! neighbouring pixels are stratified together and the error is blue noise),
-//! [`SobolCmjSampler`]
-//! (the Sobol' sampler's numbers except for the first bounce's BSDF direction, which a
-//! correlated multi-jittered pattern gives; that request sits at
+//! [`SobolCmjSampler`] (the Sobol' sampler's numbers except for the first bounce's BSDF
+//! direction, which a correlated multi-jittered pattern gives; that request sits at
 //! [`first_direction_dimension`] in the order above) and [`CmjSampler`] (correlated
 //! multi-jittered points for every request, for the study in `bench/sampler.sh`; the
 //! renderer does not offer it).
