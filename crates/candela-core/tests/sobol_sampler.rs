@@ -15,7 +15,8 @@
 
 use candela_core::sampler::{IndependentSampler, SobolSampler};
 use candela_test_support::samplers::{
-    chi2_over_pixels, draw, is_stratified, points, two_requests_are_independent, Request, REQUESTS,
+    chi2_over_pixels, draw, is_stratified, points, requests_are_uniform_across_pixels,
+    two_requests_are_independent, Request, REQUESTS,
 };
 use glam::{UVec2, Vec2};
 
@@ -85,18 +86,7 @@ const CHI2_TESTS: usize = 6;
 
 #[test]
 fn across_pixels_every_request_is_uniform() {
-    let mut s = SobolSampler::new(4);
-    for (index, req) in [
-        (0u32, Request::TwoD { skip: 0 }),
-        (5, Request::TwoD { skip: 7 }),
-        (77, Request::TwoD { skip: 40 }),
-    ] {
-        let report = chi2_over_pixels(CHI2_TESTS, &format!("sample {index}, {req:?}"), |p| {
-            draw(&mut s, p, index, req)
-        });
-        eprintln!("sample {index}, {req:?}: p = {:.3}", report.p_value);
-        report.assert_passed();
-    }
+    requests_are_uniform_across_pixels(SobolSampler::new(4), CHI2_TESTS);
 }
 
 #[test]

@@ -78,6 +78,22 @@ pub fn chi2_over_pixels(
     )
 }
 
+/// Checks three requests (the first 2D one, a later one, one past a Sobol' table's
+/// dimensions) of three sample indices, each over pixels: uniform on the square.
+pub fn requests_are_uniform_across_pixels<S: Sampler>(mut s: S, tests: usize) {
+    for (index, req) in [
+        (0u32, Request::TwoD { skip: 0 }),
+        (5, Request::TwoD { skip: 7 }),
+        (77, Request::TwoD { skip: 40 }),
+    ] {
+        let report = chi2_over_pixels(tests, &format!("sample {index}, {req:?}"), |p| {
+            draw(&mut s, p, index, req)
+        });
+        eprintln!("sample {index}, {req:?}: p = {:.3}", report.p_value);
+        report.assert_passed();
+    }
+}
+
 /// Checks the first coordinate of two different requests of one pixel sample (and a 1D
 /// request against a 2D one) over pixels: padding must leave no correlation between them.
 pub fn two_requests_are_independent<S: Sampler>(mut s: S, tests: usize) {
