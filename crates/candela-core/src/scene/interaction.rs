@@ -2,7 +2,7 @@
 //! triangle (every vertex attribute interpolated, instances carried to world space, and a
 //! fast path for bare meshes) and for a sphere.
 
-use glam::{Vec2, Vec3};
+use glam::{Vec2, Vec3, Vec3A};
 
 use super::mesh::{winding_normal, Mesh, Prim};
 use super::Scene;
@@ -10,7 +10,7 @@ use crate::geometry::Ray;
 use crate::instance::Instance;
 use crate::light::LightId;
 use crate::material::MaterialId;
-use crate::math::offset_ray_origin;
+use crate::math::offset_ray_origin_a;
 
 /// What a ray found.
 #[derive(Clone, Copy, Debug)]
@@ -39,11 +39,18 @@ impl SurfaceInteraction {
     /// A ray leaving this surface towards `d`, its origin moved off the surface.
     #[inline]
     pub fn spawn_ray(&self, d: Vec3) -> Ray {
-        Ray::new(
-            offset_ray_origin(self.p, negated_unless(self.ng, d.dot(self.ng) >= 0.0)),
-            d,
-        )
+        leaving_ray(self.p, self.ng, d)
     }
+}
+
+/// The ray leaving point `p` of a surface of normal `n` towards `d`, its origin moved off
+/// the surface to the side `d` leaves by. In SIMD lanes, bit for bit the scalar set-up (see
+/// [`super::Scene::unoccluded`]).
+#[inline(always)]
+pub(super) fn leaving_ray(p: Vec3, n: Vec3, d: Vec3) -> Ray {
+    let (pa, na, da) = (Vec3A::from(p), Vec3A::from(n), Vec3A::from(d));
+    let o = offset_ray_origin_a(pa, negated_unless_a(na, da.dot(na) >= 0.0));
+    Ray::new(o.into(), d)
 }
 
 /// `n` where `keep`, else `−n`: as a product with ±1 (exact, so bit for bit the select)
@@ -52,6 +59,12 @@ impl SurfaceInteraction {
 /// side it leaves, three times a bounce.
 #[inline(always)]
 pub(super) fn negated_unless(n: Vec3, keep: bool) -> Vec3 {
+    n * if keep { 1.0 } else { -1.0 }
+}
+
+/// [`negated_unless`] in SIMD lanes.
+#[inline(always)]
+pub(super) fn negated_unless_a(n: Vec3A, keep: bool) -> Vec3A {
     n * if keep { 1.0 } else { -1.0 }
 }
 
