@@ -50,7 +50,7 @@ pub fn li<S: Sampler>(scene: &Scene, mut ray: Ray, sampler: &mut S, rays: &mut u
             #[inline(always)]
             || BounceSamples::<S>::draw(scene, sampler),
         );
-        let hit = scene.intersect(&ray, f32::INFINITY);
+        let hit = scene.intersect_for_shading(&ray, f32::INFINITY);
         if hides_emitter(scene, depth, hit.as_ref()) {
             break;
         }

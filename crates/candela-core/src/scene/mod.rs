@@ -22,8 +22,8 @@ mod interaction;
 mod mesh;
 
 pub use interaction::SurfaceInteraction;
-use interaction::{leaving_ray, negated_unless_a, triangle_interaction};
-pub use mesh::{Mesh, Prim, Sphere};
+use interaction::{instance_triangle_interaction, leaving_ray, negated_unless_a};
+pub use mesh::{Mesh, Prim, ShadingRecord, Sphere};
 
 /// The scene as the integrator sees it. Made by [`crate::build::build`].
 #[derive(Clone, Debug)]
@@ -71,13 +71,28 @@ impl Scene {
         &self.lights[id.0 as usize]
     }
 
-    /// The nearest surface along the ray within (0, t_max).
+    /// The nearest surface along the ray within (0, t_max), its hit record complete.
     ///
     /// Inlined, with the instances and spheres out of line: the hit record of a flat
     /// triangle, the common case, is built in the caller with no call. (Inlining the rare
     /// paths too, so that no record comes back through memory, measured no faster.)
     #[inline(always)]
     pub fn intersect(&self, ray: &Ray, t_max: f32) -> Option<SurfaceInteraction> {
+        self.nearest::<false>(ray, t_max)
+    }
+
+    /// [`Scene::intersect`] for shading: the record's uvs, ∂p/∂u and bitangent sign are
+    /// placeholders where nothing that shades the hit reads them (its mesh's
+    /// [`Mesh::shading_record`]), and not computed. The path integrator's query.
+    #[inline(always)]
+    pub fn intersect_for_shading(&self, ray: &Ray, t_max: f32) -> Option<SurfaceInteraction> {
+        self.nearest::<true>(ray, t_max)
+    }
+
+    /// [`Scene::intersect`], the record as [`Scene::intersect_for_shading`]'s where
+    /// `SHADING`.
+    #[inline(always)]
+    fn nearest<const SHADING: bool>(&self, ray: &Ray, t_max: f32) -> Option<SurfaceInteraction> {
         let hit = self
             .accel
             .intersect(ray, t_max, |i, hit| self.alpha_accepts(i, hit, ray));
@@ -88,7 +103,7 @@ impl Scene {
         }
         let hit = hit?;
         let prim = self.prims[hit.prim as usize];
-        Some(self.interaction(ray, prim, hit.t, Vec2::new(hit.b1, hit.b2)))
+        self.interaction(ray, prim, hit.t, Vec2::new(hit.b1, hit.b2), SHADING)
     }
 
     /// The nearest instanced surface along the ray within (0, t_max).
@@ -98,13 +113,7 @@ impl Scene {
         let h = self.instances.intersect(ray, t_max, filter)?;
         let inst = &self.instances.instances[h.instance as usize];
         let m = &self.instances.meshes[inst.mesh as usize];
-        Some(triangle_interaction(
-            m,
-            Some(inst),
-            h.tri,
-            h.t,
-            Vec2::new(h.b1, h.b2),
-        ))
+        instance_triangle_interaction(m, inst, h.tri, h.t, Vec2::new(h.b1, h.b2))
     }
 
     /// Whether anything lies on the ray within (0, t_max).
