@@ -44,6 +44,7 @@ def main():
             frames[cur].append((ln, next(it)))  # (function, file:line), innermost first
     by_stage = defaultdict(float)
     by_line = defaultdict(float)
+    by_file = defaultdict(float)
     total = 0.0
     kept = []
     for addr, d in rows:
@@ -55,9 +56,13 @@ def main():
         inner = next((loc for _, loc in chain if "candela-" in loc), "?")
         by_stage[stage_of(inner) or "other"] += d
         by_line[inner.split("/src/")[-1]] += d
+        by_file[inner.split("/src/")[-1].split(":")[0]] += d
     print(f"inside {func}: {total:.0f} instructions a path")
     for s, v in sorted(by_stage.items(), key=lambda kv: -kv[1]):
         print(f"  {s:14s} {v:8.1f}")
+    print("by source file:")
+    for f, v in sorted(by_file.items(), key=lambda kv: -kv[1]):
+        print(f"  {v:8.1f} {f}")
     print("by source line:")
     for loc, v in sorted(by_line.items(), key=lambda kv: -kv[1])[:lines]:
         print(f"  {v:8.1f} {loc}")
