@@ -167,6 +167,37 @@ impl Material {
         }
     }
 
+    /// Whether [`Self::bsdf_at`] reads the hit's uvs: a texture that is not constant, or
+    /// a normal map.
+    pub fn reads_uv(&self) -> bool {
+        let varies = |t: &Texture| !matches!(t, Texture::Constant(_));
+        match self {
+            Material::Diffuse { albedo } => varies(albedo),
+            Material::Fixed(_) => false,
+            Material::Plastic { albedo, .. } => varies(albedo),
+            Material::MetalRough {
+                base_color,
+                metallic,
+                roughness,
+            } => varies(base_color) || varies(metallic) || varies(roughness),
+            Material::Dielectric { tint, .. } => varies(tint),
+            Material::NormalMap { .. } => true,
+            Material::OneSided(inner) => inner.reads_uv(),
+            Material::Mix { weight, a, b, .. } => varies(weight) || a.reads_uv() || b.reads_uv(),
+        }
+    }
+
+    /// Whether [`Self::bsdf_at`] reads the hit's ∂p/∂u or bitangent sign: every lobe's
+    /// frame but a Lambertian one's, and normal maps.
+    pub fn reads_dpdu(&self) -> bool {
+        match self {
+            Material::Diffuse { .. } => false,
+            Material::OneSided(inner) => inner.reads_dpdu(),
+            Material::Mix { a, b, .. } => a.reads_dpdu() || b.reads_dpdu(),
+            _ => true,
+        }
+    }
+
     /// The [`Material::Mix`] of `a` and `b` by `weight`, its level one above theirs.
     pub fn mix(weight: Texture, a: Material, b: Material) -> Material {
         Material::Mix {
@@ -368,5 +399,49 @@ mod mix_tests {
             };
             assert_eq!(chosen(&m, p, uv), expected, "uv {uv}");
         }
+    }
+
+    /// What a material's BSDF reads of the hit: uvs where a texture varies or a normal
+    /// map bends the normal, ∂p/∂u for every frame but a Lambertian one's, through
+    /// one-sided and mixed materials.
+    #[test]
+    fn materials_say_which_surface_parameters_they_read() {
+        let checker = Texture::Checker {
+            a: Vec3::ZERO,
+            b: Vec3::ONE,
+            uv_transform: glam::Affine2::IDENTITY,
+        };
+        let textured = Material::Diffuse {
+            albedo: checker.clone(),
+        };
+        let metal = Material::MetalRough {
+            base_color: Texture::Constant(Vec3::ONE),
+            metallic: Texture::Constant(Vec3::ONE),
+            roughness: Texture::Constant(Vec3::splat(0.3)),
+        };
+        let reads = |m: &Material| (m.reads_uv(), m.reads_dpdu());
+        assert_eq!(reads(&diffuse(0.5)), (false, false));
+        assert_eq!(reads(&textured), (true, false));
+        assert_eq!(reads(&metal), (false, true));
+        let normal_mapped = Material::NormalMap {
+            map: Texture::Constant(Vec3::new(0.5, 0.5, 1.0)),
+            inner: Box::new(diffuse(0.5)),
+        };
+        assert_eq!(reads(&normal_mapped), (true, true));
+        assert_eq!(
+            reads(&Material::OneSided(Box::new(diffuse(0.5)))),
+            (false, false)
+        );
+        let constant_weight = Texture::Constant(Vec3::splat(0.5));
+        let mix = Material::mix(constant_weight.clone(), diffuse(0.2), diffuse(0.8));
+        assert_eq!(reads(&mix), (false, false));
+        assert_eq!(
+            reads(&Material::mix(checker, diffuse(0.2), diffuse(0.8))),
+            (true, false)
+        );
+        assert_eq!(
+            reads(&Material::mix(constant_weight, diffuse(0.2), metal)),
+            (false, true)
+        );
     }
 }

@@ -209,6 +209,14 @@ fn build_taking(desc: &SceneDesc, mut taken: Vec<Option<MeshDesc>>) -> Result<Sc
     if triangles + spheres.len() < INDEXED_FROM {
         meshes.iter_mut().for_each(Mesh::cache_uv_tangents);
     }
+    for m in &mut meshes {
+        // An emitting mesh's lights may read the uvs (emission textures).
+        let material = &materials[m.material.0 as usize];
+        m.cache_shading_record(
+            material.reads_uv() || !m.lights.is_empty(),
+            material.reads_dpdu(),
+        );
+    }
     let mut prims = Vec::with_capacity(triangles + spheres.len());
     for (mi, m) in meshes.iter().enumerate() {
         prims.extend((0..m.indices.len() as u32).map(|tri| Prim::Triangle {

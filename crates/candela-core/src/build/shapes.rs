@@ -134,6 +134,7 @@ pub(super) fn to_world(local: MeshDesc, m: Mat4, material: MaterialId) -> Mesh {
         alpha: None,
         face_normals: Vec::new(),
         face_dpdu: Vec::new(),
+        shading_record: Default::default(),
     }
 }
 
@@ -154,6 +155,7 @@ pub(super) fn object_space(local: MeshDesc, material: MaterialId) -> Mesh {
         alpha: None,
         face_normals: Vec::new(),
         face_dpdu: Vec::new(),
+        shading_record: Default::default(),
     }
 }
 

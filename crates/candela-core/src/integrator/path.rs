@@ -2,7 +2,7 @@
 //! estimation (see `direct`), a BSDF-sampled bounce and Russian roulette on the
 //! throughput. Scenes with media go to `volpath` instead.
 
-use glam::{Vec2, Vec3};
+use glam::{Vec2, Vec3, Vec3A};
 
 use super::copies::sample_direct_baseline;
 #[cfg(target_arch = "x86_64")]
@@ -50,7 +50,7 @@ pub fn li<S: Sampler>(scene: &Scene, mut ray: Ray, sampler: &mut S, rays: &mut u
             #[inline(always)]
             || BounceSamples::<S>::draw(scene, sampler),
         );
-        let hit = scene.intersect(&ray, f32::INFINITY);
+        let hit = scene.intersect_for_shading(&ray, f32::INFINITY);
         if hides_emitter(scene, depth, hit.as_ref()) {
             break;
         }
@@ -103,11 +103,20 @@ pub fn li<S: Sampler>(scene: &Scene, mut ray: Ray, sampler: &mut S, rays: &mut u
             }
             beta *= 1.0 / (1.0 - q);
         }
-        if beta == Vec3::ZERO || !beta.is_finite() {
+        if is_spent(beta) {
             break;
         }
     }
     l
+}
+
+/// Whether the throughput `beta` ends the path: every channel zero, or one not finite.
+/// In SIMD lanes (|β| < ∞ is false for ∞ and NaN), where `is_finite` was integer tests on
+/// each channel's bits: the same answer for a few instructions.
+#[inline(always)]
+fn is_spent(beta: Vec3) -> bool {
+    let b = Vec3A::from(beta);
+    b == Vec3A::ZERO || !b.abs().cmplt(Vec3A::INFINITY).all()
 }
 
 /// What emission found by BSDF sampling is weighed against: where the path left its last
@@ -286,5 +295,40 @@ impl<S: Sampler> BounceSamples<S> {
             lobe,
             dir,
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// `is_spent` is main's `beta == Vec3::ZERO || !beta.is_finite()`, channel by channel:
+    /// zeros of either sign, infinities and NaN in each position.
+    #[test]
+    fn a_path_is_spent_where_its_throughput_is_zero_or_not_finite() {
+        let values = [
+            0.0,
+            -0.0,
+            1e-38,
+            0.5,
+            -2.0,
+            3e38,
+            f32::INFINITY,
+            -f32::INFINITY,
+            f32::NAN,
+        ];
+        let mut spent = 0;
+        for &x in &values {
+            for &y in &values {
+                for &z in &values {
+                    let beta = Vec3::new(x, y, z);
+                    let expected = beta == Vec3::ZERO || !beta.is_finite();
+                    assert_eq!(is_spent(beta), expected, "{beta:?}");
+                    spent += expected as u32;
+                }
+            }
+        }
+        // 8 all-zero triples, 9³ − 6³ with an infinity or NaN.
+        assert_eq!(spent, 8 + 729 - 216);
     }
 }

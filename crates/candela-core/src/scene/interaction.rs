@@ -2,15 +2,15 @@
 //! triangle (every vertex attribute interpolated, instances carried to world space, and a
 //! fast path for bare meshes) and for a sphere.
 
-use glam::{Vec2, Vec3};
+use glam::{Vec2, Vec3, Vec3A};
 
-use super::mesh::{winding_normal, Mesh, Prim};
+use super::mesh::{winding_normal, Mesh, Prim, ShadingRecord};
 use super::Scene;
 use crate::geometry::Ray;
 use crate::instance::Instance;
 use crate::light::LightId;
 use crate::material::MaterialId;
-use crate::math::offset_ray_origin;
+use crate::math::offset_ray_origin_a;
 
 /// What a ray found.
 #[derive(Clone, Copy, Debug)]
@@ -39,11 +39,18 @@ impl SurfaceInteraction {
     /// A ray leaving this surface towards `d`, its origin moved off the surface.
     #[inline]
     pub fn spawn_ray(&self, d: Vec3) -> Ray {
-        Ray::new(
-            offset_ray_origin(self.p, negated_unless(self.ng, d.dot(self.ng) >= 0.0)),
-            d,
-        )
+        leaving_ray(self.p, self.ng, d)
     }
+}
+
+/// The ray leaving point `p` of a surface of normal `n` towards `d`, its origin moved off
+/// the surface to the side `d` leaves by. In SIMD lanes, bit for bit the scalar set-up (see
+/// [`super::Scene::unoccluded`]).
+#[inline(always)]
+pub(super) fn leaving_ray(p: Vec3, n: Vec3, d: Vec3) -> Ray {
+    let (pa, na, da) = (Vec3A::from(p), Vec3A::from(n), Vec3A::from(d));
+    let o = offset_ray_origin_a(pa, negated_unless_a(na, da.dot(na) >= 0.0));
+    Ray::new(o.into(), d)
 }
 
 /// `n` where `keep`, else `−n`: as a product with ±1 (exact, so bit for bit the select)
@@ -55,7 +62,20 @@ pub(super) fn negated_unless(n: Vec3, keep: bool) -> Vec3 {
     n * if keep { 1.0 } else { -1.0 }
 }
 
+/// [`negated_unless`] in SIMD lanes.
+#[inline(always)]
+pub(super) fn negated_unless_a(n: Vec3A, keep: bool) -> Vec3A {
+    n * if keep { 1.0 } else { -1.0 }
+}
+
+/// The hit records come back as `Option`s, `Some` always, the type the ray query returns:
+/// the out-of-line ones are then written straight where the caller keeps the query's
+/// answer. Returned bare, each was written to a slot of the call and copied into the
+/// `Option` after it (22 instructions a hit).
 impl Scene {
+    /// The hit record of `prim` at distance `t` along `ray`, barycentrics `bary` on a
+    /// triangle: every attribute ([`ShadingRecord::Full`] or [`ShadingRecord::Bare`]), or
+    /// where `shading`, what the mesh's shading reads ([`Mesh::shading_record`]).
     #[inline(always)]
     pub(super) fn interaction(
         &self,
@@ -63,10 +83,21 @@ impl Scene {
         prim: Prim,
         t: f32,
         bary: Vec2,
-    ) -> SurfaceInteraction {
+        shading: bool,
+    ) -> Option<SurfaceInteraction> {
         match prim {
             Prim::Triangle { mesh, tri } => {
-                triangle_interaction(&self.meshes[mesh as usize], None, tri, t, bary)
+                let m = &self.meshes[mesh as usize];
+                let record = match shading {
+                    true => m.shading_record,
+                    false if m.is_bare() => ShadingRecord::Bare,
+                    false => ShadingRecord::Full,
+                };
+                match record {
+                    ShadingRecord::Bare => Some(bare_triangle_interaction(m, tri, t, bary)),
+                    ShadingRecord::Normals => Some(normals_triangle_interaction(m, tri, t, bary)),
+                    ShadingRecord::Full => world_triangle_interaction(m, tri, t, bary),
+                }
             }
             Prim::Sphere(i) => self.sphere_interaction(ray, i, t),
         }
@@ -74,7 +105,7 @@ impl Scene {
 
     /// The hit record of sphere `i` at distance `t` along the ray.
     #[inline(never)]
-    fn sphere_interaction(&self, ray: &Ray, i: u32, t: f32) -> SurfaceInteraction {
+    fn sphere_interaction(&self, ray: &Ray, i: u32, t: f32) -> Option<SurfaceInteraction> {
         let s = &self.spheres[i as usize];
         let n_out = (ray.at(t) - s.center).normalize();
         // Project back onto the surface to remove the error of o + t·d.
@@ -85,7 +116,7 @@ impl Scene {
             (phi / std::f32::consts::TAU).rem_euclid(1.0),
             n_out.y.clamp(-1.0, 1.0).acos() / std::f32::consts::PI,
         );
-        SurfaceInteraction {
+        Some(SurfaceInteraction {
             p,
             t,
             ng: n,
@@ -97,36 +128,39 @@ impl Scene {
             color: Vec3::ONE,
             material: s.material,
             light: s.light,
-        }
+        })
     }
 }
 
-/// The hit record of triangle `tri` of `m` at barycentrics `bary`: a world-space mesh's
-/// where `inst` is `None`, else an instance's, whose object-space vertex data is carried to
-/// world space first by the same [`crate::instance::Transform`] that flattens meshes.
+/// The hit record of triangle `tri` of instance `inst`'s mesh `m` at barycentrics `bary`:
+/// its object-space vertex data carried to world space first by the same
+/// [`crate::instance::Transform`] that flattens meshes.
 #[inline(always)]
-pub(super) fn triangle_interaction(
+pub(super) fn instance_triangle_interaction(
     m: &Mesh,
-    inst: Option<&Instance>,
+    inst: &Instance,
     tri: u32,
     t: f32,
     bary: Vec2,
-) -> SurfaceInteraction {
-    match inst {
-        None if m.is_bare() => bare_triangle_interaction(m, tri, t, bary),
-        None => world_triangle_interaction(m, tri, t, bary),
-        Some(_) => full_triangle_interaction(m, inst, tri, t, bary),
-    }
+) -> Option<SurfaceInteraction> {
+    Some(full_triangle_interaction(m, Some(inst), tri, t, bary))
 }
 
 /// [`full_triangle_interaction`] of a world-space mesh: a copy of its own, out of line,
 /// in which every test of the instance (its material, flip and transform) folds away.
 #[inline(never)]
-fn world_triangle_interaction(m: &Mesh, tri: u32, t: f32, bary: Vec2) -> SurfaceInteraction {
-    full_triangle_interaction(m, None, tri, t, bary)
+fn world_triangle_interaction(
+    m: &Mesh,
+    tri: u32,
+    t: f32,
+    bary: Vec2,
+) -> Option<SurfaceInteraction> {
+    Some(full_triangle_interaction(m, None, tri, t, bary))
 }
 
-/// [`triangle_interaction`] with every vertex attribute the mesh has interpolated.
+/// The hit record of triangle `tri` of `m` at barycentrics `bary`, every vertex attribute
+/// the mesh has interpolated: a world-space mesh's where `inst` is `None`, else an
+/// instance's (see [`instance_triangle_interaction`]).
 #[inline(always)]
 fn full_triangle_interaction(
     m: &Mesh,
@@ -167,10 +201,9 @@ fn full_triangle_interaction(
     };
     let mut ns = ng;
     if let Some([na, nb, nc]) = normals {
-        let n = (na * b0 + nb * bary.x + nc * bary.y).normalize_or_zero();
-        if n != Vec3::ZERO {
-            // A product with ±1, exact (n is finite here: `normalize_or_zero` gives zero
-            // for anything else), where the select of −n or n was a broadcast mask.
+        if let Some(n) = unit(na * b0 + nb * bary.x + nc * bary.y) {
+            // A product with ±1, exact (n is finite here), where the select of −n or n
+            // was a broadcast mask.
             ns = negated_unless(n, !flip_normals);
         }
     }
@@ -220,7 +253,7 @@ fn carried_normal(xf: Option<&crate::instance::Transform>, n: Vec3) -> Vec3 {
     }
 }
 
-/// [`triangle_interaction`] of a world-space mesh with positions only (no normals, uvs,
+/// [`full_triangle_interaction`] of a world-space mesh with positions only (no normals, uvs,
 /// tangents or colours, the Cornell box's walls): the same record, without the branches
 /// and interpolations of the attributes it lacks. The uvs are the barycentrics, ∂p/∂u is
 /// p₁ − p₀, as in the general case.
@@ -240,6 +273,49 @@ fn bare_triangle_interaction(m: &Mesh, tri: u32, t: f32, bary: Vec2) -> SurfaceI
         color: Vec3::ONE,
         material: m.material,
         light: m.lights.get(tri as usize).copied(),
+    }
+}
+
+/// The hit record of a world-space mesh of [`ShadingRecord::Normals`]:
+/// the position, the cached geometric normal and the shading normal from the vertex
+/// normals, as [`full_triangle_interaction`] makes them; the uvs, ∂p/∂u and bitangent sign,
+/// which this mesh's shading does not read, as the bare record's.
+#[inline(always)]
+fn normals_triangle_interaction(m: &Mesh, tri: u32, t: f32, bary: Vec2) -> SurfaceInteraction {
+    let [a, b, c] = m.indices[tri as usize].map(|i| i as usize);
+    let [p0, p1, p2] = [m.positions[a], m.positions[b], m.positions[c]];
+    let [na, nb, nc] = [m.normals[a], m.normals[b], m.normals[c]];
+    let b0 = 1.0 - bary.x - bary.y;
+    let ng = m.geometric_normal(tri);
+    let ns = match unit(na * b0 + nb * bary.x + nc * bary.y) {
+        Some(n) => negated_unless(n, !m.flip_normals),
+        None => ng,
+    };
+    SurfaceInteraction {
+        p: p0 * b0 + p1 * bary.x + p2 * bary.y,
+        t,
+        ng,
+        ns,
+        uv: bary,
+        dpdu: p1 - p0,
+        bitangent_sign: 1.0,
+        color: Vec3::ONE,
+        material: m.material,
+        light: m.lights.get(tri as usize).copied(),
+    }
+}
+
+/// `v` scaled to unit length, `None` where that is not a finite, non-zero vector: glam's
+/// `normalize_or_zero` bit for bit (`None` for its zero), with the reciprocal's range
+/// checked by two compares where `is_finite` was a dozen integer instructions on its bits.
+#[inline(always)]
+fn unit(v: Vec3) -> Option<Vec3> {
+    let rcp = 1.0 / v.length();
+    // An `if`, not `bool::then` with a closure (see `full_triangle_interaction`).
+    if rcp > 0.0 && rcp < f32::INFINITY {
+        Some(v * rcp)
+    } else {
+        None
     }
 }
 
@@ -293,6 +369,7 @@ mod tests {
             alpha: None,
             face_normals: vec![],
             face_dpdu: vec![],
+            shading_record: Default::default(),
         }
     }
 
@@ -328,8 +405,79 @@ mod tests {
             assert_eq!(records(&m), computed);
         }
         m.lights.clear();
-        let si = triangle_interaction(&m, None, 1, 1.0, Vec2::splat(0.25));
+        let si = bare_triangle_interaction(&m, 1, 1.0, Vec2::splat(0.25));
         assert!(si.light.is_none());
+    }
+
+    /// The [`ShadingRecord::Normals`] record is the full one but for the fields its
+    /// mesh's shading does not read (uvs, ∂p/∂u, bitangent sign: the bare placeholders),
+    /// bit for bit, with and without `flip_normals`, cached normals and a light; and
+    /// `cache_shading_record` picks it only where nothing reads those fields.
+    #[test]
+    fn the_normals_record_is_the_full_one_where_shading_reads() {
+        let mut m = mesh(
+            vec![
+                Vec3::new(0.1, 0.2, 0.3),
+                Vec3::new(1.7, -0.4, 0.2),
+                Vec3::new(0.3, 1.1, -0.9),
+                Vec3::new(-0.5, 0.6, 2.0),
+            ],
+            vec![
+                Vec3::new(0.2, 0.9, 0.1).normalize(),
+                Vec3::new(-0.3, 0.8, 0.2).normalize(),
+                Vec3::new(0.1, 0.7, -0.6).normalize(),
+                // Opposite to vertex 1's: triangle 1's normals sum to zero at (0, ½, ½).
+                -Vec3::new(-0.3, 0.8, 0.2).normalize(),
+            ],
+            vec![[0, 1, 2], [2, 1, 3], [1, 2, 1]],
+        );
+        m.uvs = vec![Vec2::ZERO, Vec2::X, Vec2::Y, Vec2::ONE];
+        m.lights = vec![LightId(1), LightId(2), LightId(3)];
+        let shaded = |si: &SurfaceInteraction| {
+            let SurfaceInteraction {
+                p,
+                t,
+                ng,
+                ns,
+                color,
+                material,
+                light,
+                ..
+            } = *si;
+            format!("{:?}", (p, t, ng, ns, color, material, light))
+        };
+        for (flip, cached) in [(false, false), (true, false), (false, true), (true, true)] {
+            m.flip_normals = flip;
+            m.face_normals.clear();
+            if cached {
+                m.cache_face_normals();
+            }
+            for tri in 0..3 {
+                for bary in [Vec2::new(0.2, 0.3), Vec2::new(0.5, 0.5), Vec2::ZERO] {
+                    let full = full_triangle_interaction(&m, None, tri, 1.5, bary);
+                    let lean = normals_triangle_interaction(&m, tri, 1.5, bary);
+                    assert_eq!(shaded(&lean), shaded(&full), "tri {tri} at {bary}");
+                    let [p0, p1, _] = m.vertices(tri);
+                    assert_eq!(
+                        (lean.uv, lean.dpdu, lean.bitangent_sign),
+                        (bary, p1 - p0, 1.0)
+                    );
+                }
+            }
+        }
+        // Only a mesh with normals, no colours, whose shading reads no uvs or ∂p/∂u.
+        m.cache_shading_record(false, false);
+        assert_eq!(m.shading_record, ShadingRecord::Normals);
+        for (reads_uv, reads_dpdu) in [(true, false), (false, true), (true, true)] {
+            m.cache_shading_record(reads_uv, reads_dpdu);
+            assert_eq!(m.shading_record, ShadingRecord::Full);
+        }
+        m.colors = vec![Vec3::ONE; 4];
+        m.cache_shading_record(false, false);
+        assert_eq!(m.shading_record, ShadingRecord::Full);
+        let mut bare = mesh(m.positions.clone(), vec![], m.indices.clone());
+        bare.cache_shading_record(true, true);
+        assert_eq!(bare.shading_record, ShadingRecord::Bare);
     }
 
     #[test]

@@ -40,6 +40,26 @@ pub struct Mesh {
     pub face_dpdu: Vec<Vec4>,
     /// Where the surface is cut out or see-through (glTF alpha modes); see [`crate::alpha`].
     pub alpha: Option<crate::alpha::AlphaMask>,
+    /// The hit record the integrators' query ([`super::Scene::intersect_for_shading`])
+    /// makes on this mesh, set by [`Mesh::cache_shading_record`] once the mesh and what
+    /// its shading reads are known; [`ShadingRecord::Full`] (always right) until then.
+    pub shading_record: ShadingRecord,
+}
+
+/// Which hit record a mesh's shading needs: each kind leaves out work whose fields no one
+/// reads, so that the integrators' hits skip it (see [`Mesh::cache_shading_record`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum ShadingRecord {
+    /// Every attribute interpolated ([`super::Scene::intersect`]'s record).
+    #[default]
+    Full,
+    /// Positions only ([`Mesh::is_bare`]): the full record, without attribute branches.
+    Bare,
+    /// The shading normal from the vertex normals, and nothing else that the mesh has:
+    /// no colours, and neither the material nor the emission reads the uvs, ∂p/∂u or the
+    /// bitangent sign, which hold the bare record's placeholders (the barycentrics,
+    /// p₁ − p₀, +1). Most scenes' constant Lambertian walls loaded with normals and uvs.
+    Normals,
 }
 
 impl Mesh {
@@ -111,6 +131,20 @@ impl Mesh {
                     dpdu.extend(sign)
                 })
                 .collect()
+        };
+    }
+
+    /// Sets [`Mesh::shading_record`] for a world-space mesh whose shading reads the uvs
+    /// where `reads_uv` (textures, normal maps, mix weights, textured emission) and ∂p/∂u
+    /// with the bitangent sign where `reads_dpdu` (every frame but a Lambertian one), after
+    /// the last change to its attributes.
+    pub fn cache_shading_record(&mut self, reads_uv: bool, reads_dpdu: bool) {
+        self.shading_record = if self.is_bare() {
+            ShadingRecord::Bare
+        } else if !self.normals.is_empty() && self.colors.is_empty() && !reads_uv && !reads_dpdu {
+            ShadingRecord::Normals
+        } else {
+            ShadingRecord::Full
         };
     }
 

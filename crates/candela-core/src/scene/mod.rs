@@ -5,7 +5,7 @@
 //! and primitive ids in `mesh`; the hit record a query returns, and how it is made for
 //! triangles and spheres, in `interaction`.
 
-use glam::{Vec2, Vec3};
+use glam::{Vec2, Vec3, Vec3A};
 
 use crate::accel::Accel;
 use crate::camera::Camera;
@@ -15,15 +15,15 @@ use crate::instance::Instances;
 use crate::light::{Light, LightId};
 use crate::light_sampler::LightSampler;
 use crate::material::Material;
-use crate::math::offset_ray_origin;
+use crate::math::offset_ray_origin_a;
 use crate::options::RenderOptions;
 
 mod interaction;
 mod mesh;
 
 pub use interaction::SurfaceInteraction;
-use interaction::{negated_unless, triangle_interaction};
-pub use mesh::{Mesh, Prim, Sphere};
+use interaction::{instance_triangle_interaction, leaving_ray, negated_unless_a};
+pub use mesh::{Mesh, Prim, ShadingRecord, Sphere};
 
 /// The scene as the integrator sees it. Made by [`crate::build::build`].
 #[derive(Clone, Debug)]
@@ -71,13 +71,28 @@ impl Scene {
         &self.lights[id.0 as usize]
     }
 
-    /// The nearest surface along the ray within (0, t_max).
+    /// The nearest surface along the ray within (0, t_max), its hit record complete.
     ///
     /// Inlined, with the instances and spheres out of line: the hit record of a flat
     /// triangle, the common case, is built in the caller with no call. (Inlining the rare
     /// paths too, so that no record comes back through memory, measured no faster.)
     #[inline(always)]
     pub fn intersect(&self, ray: &Ray, t_max: f32) -> Option<SurfaceInteraction> {
+        self.nearest::<false>(ray, t_max)
+    }
+
+    /// [`Scene::intersect`] for shading: the record's uvs, ∂p/∂u and bitangent sign are
+    /// placeholders where nothing that shades the hit reads them (its mesh's
+    /// [`Mesh::shading_record`]), and not computed. The path integrator's query.
+    #[inline(always)]
+    pub fn intersect_for_shading(&self, ray: &Ray, t_max: f32) -> Option<SurfaceInteraction> {
+        self.nearest::<true>(ray, t_max)
+    }
+
+    /// [`Scene::intersect`], the record as [`Scene::intersect_for_shading`]'s where
+    /// `SHADING`.
+    #[inline(always)]
+    fn nearest<const SHADING: bool>(&self, ray: &Ray, t_max: f32) -> Option<SurfaceInteraction> {
         let hit = self
             .accel
             .intersect(ray, t_max, |i, hit| self.alpha_accepts(i, hit, ray));
@@ -88,7 +103,7 @@ impl Scene {
         }
         let hit = hit?;
         let prim = self.prims[hit.prim as usize];
-        Some(self.interaction(ray, prim, hit.t, Vec2::new(hit.b1, hit.b2)))
+        self.interaction(ray, prim, hit.t, Vec2::new(hit.b1, hit.b2), SHADING)
     }
 
     /// The nearest instanced surface along the ray within (0, t_max).
@@ -98,13 +113,7 @@ impl Scene {
         let h = self.instances.intersect(ray, t_max, filter)?;
         let inst = &self.instances.instances[h.instance as usize];
         let m = &self.instances.meshes[inst.mesh as usize];
-        Some(triangle_interaction(
-            m,
-            Some(inst),
-            h.tri,
-            h.t,
-            Vec2::new(h.b1, h.b2),
-        ))
+        instance_triangle_interaction(m, inst, h.tri, h.t, Vec2::new(h.b1, h.b2))
     }
 
     /// Whether anything lies on the ray within (0, t_max).
@@ -128,14 +137,22 @@ impl Scene {
     /// Whether the segment from surface point `from` (normal `n_from`) to point `to`
     /// (normal `n_to`, zero for a point light) is unblocked. Both ends are moved off their
     /// surfaces so that neither surface blocks its own ray.
-    #[inline]
+    ///
+    /// The set-up runs in SIMD lanes ([`Vec3A`]): glam's lane dot product and length sum
+    /// x, y, z in the order of [`Vec3`]'s, so the ray is the scalar code's bit for bit,
+    /// for fewer instructions (no packing into lanes and back around the two offsets,
+    /// vector subtractions and products). Inlined, so that the render loop's x86-64-v3
+    /// copy gets it compiled for v3: out of line, one baseline copy served both loops.
+    #[inline(always)]
     pub fn unoccluded(&self, from: Vec3, n_from: Vec3, to: Vec3, n_to: Vec3) -> bool {
+        let (from, n_from) = (Vec3A::from(from), Vec3A::from(n_from));
+        let (to, n_to) = (Vec3A::from(to), Vec3A::from(n_to));
         let d = to - from;
-        let o = offset_ray_origin(from, negated_unless(n_from, d.dot(n_from) >= 0.0));
-        let target = if n_to == Vec3::ZERO {
+        let o = offset_ray_origin_a(from, negated_unless_a(n_from, d.dot(n_from) >= 0.0));
+        let target = if n_to == Vec3A::ZERO {
             to
         } else {
-            offset_ray_origin(to, negated_unless(n_to, d.dot(n_to) <= 0.0))
+            offset_ray_origin_a(to, negated_unless_a(n_to, d.dot(n_to) <= 0.0))
         };
         let d = target - o;
         let dist = d.length();
@@ -145,13 +162,14 @@ impl Scene {
             return dist == 0.0;
         }
         // A relative margin keeps the far end from blocking itself.
-        !self.occluded(&Ray::new(o, d * (1.0 / dist)), dist * (1.0 - 1e-4))
+        let ray = Ray::new(o.into(), (d * (1.0 / dist)).into());
+        !self.occluded(&ray, dist * (1.0 - 1e-4))
     }
 
-    /// Whether a ray leaving `from` towards `d` escapes the scene.
-    #[inline]
+    /// Whether a ray leaving `from` towards `d` escapes the scene (inlined as
+    /// [`Scene::unoccluded`]).
+    #[inline(always)]
     pub fn escapes(&self, from: Vec3, n_from: Vec3, d: Vec3) -> bool {
-        let o = offset_ray_origin(from, negated_unless(n_from, d.dot(n_from) >= 0.0));
-        !self.occluded(&Ray::new(o, d), f32::INFINITY)
+        !self.occluded(&leaving_ray(from, n_from, d), f32::INFINITY)
     }
 }
