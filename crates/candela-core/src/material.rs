@@ -93,7 +93,7 @@ impl Material {
     /// handled here and inlined into the caller, which then need not read the BSDF back
     /// from memory; the rest goes through [`Self::bsdf_at_general`]. (Out of line, the
     /// checkerboard walls of `bench/scenes/cornell-textured.xml` spent ~60 instructions a
-    /// hit on the call's prologue and on writing the 160-byte BSDF out and reading it
+    /// hit on the call's prologue and on writing the 164-byte BSDF out and reading it
     /// back.)
     #[inline(always)]
     pub fn bsdf_at(&self, si: &SurfaceInteraction) -> Bsdf {
