@@ -89,23 +89,28 @@ impl Material {
     /// sign), uvs, and vertex colour multiplying the base colour (diffuse and plastic
     /// albedo, metal_rough base colour; other lobes ignore it).
     ///
-    /// A constant Lambertian material, most scenes' walls, is handled here and inlined
-    /// into the caller, which then need not read the BSDF back from memory; the rest goes
-    /// through [`Self::bsdf_at_general`].
+    /// A Lambertian material of constant or checkerboard albedo, most scenes' walls, is
+    /// handled here and inlined into the caller, which then need not read the BSDF back
+    /// from memory; the rest goes through [`Self::bsdf_at_general`]. (Out of line, the
+    /// checkerboard walls of `bench/scenes/cornell-textured.xml` spent ~60 instructions a
+    /// hit on the call's prologue and on writing the 164-byte BSDF out and reading it
+    /// back.)
     #[inline(always)]
     pub fn bsdf_at(&self, si: &SurfaceInteraction) -> Bsdf {
         if let Material::Diffuse {
-            albedo: Texture::Constant(_),
+            albedo: albedo @ (Texture::Constant(_) | Texture::Checker { .. }),
         } = self
         {
-            // `lobe` and the texture's `eval` inline here to the constant times the
-            // vertex colour.
-            return Bsdf::new(si.ns, si.ng, self.lobe(si.uv, si.color));
+            // The texture's `eval` inlines here to the constant, or the checker's choice,
+            // times the vertex colour, as `lobe` computes it.
+            let albedo = albedo.eval(si.uv) * si.color;
+            return Bsdf::new(si.ns, si.ng, Lobe::Diffuse(Diffuse { albedo }));
         }
         self.bsdf_at_general(si)
     }
 
-    /// [`Self::bsdf_at`] of every material but a constant Lambertian one.
+    /// [`Self::bsdf_at`] of every material but a Lambertian one of constant or checkerboard
+    /// albedo.
     #[inline(never)]
     fn bsdf_at_general(&self, si: &SurfaceInteraction) -> Bsdf {
         match self {

@@ -49,20 +49,23 @@ impl Conductor {
     }
 
     pub fn f(&self, wo: Vec3, wi: Vec3) -> Vec3 {
-        if self.is_delta() || wo.z <= 0.0 || wi.z <= 0.0 {
-            return Vec3::ZERO;
-        }
-        let Some((wm, dg)) = self.distrib.reflection(wo, wi) else {
-            return Vec3::ZERO;
-        };
-        self.fresnel.eval(wo.dot(wm)) * dg
+        self.f_pdf(wo, wi).0
     }
 
     pub fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
+        self.f_pdf(wo, wi).1
+    }
+
+    /// [`Self::f`] and [`Self::pdf`] at once: one half vector, one D and one Λ(ωo) for
+    /// both.
+    pub fn f_pdf(&self, wo: Vec3, wi: Vec3) -> (Vec3, f32) {
         if self.is_delta() || wo.z <= 0.0 || wi.z <= 0.0 {
-            return 0.0;
+            return (Vec3::ZERO, 0.0);
         }
-        self.distrib.reflection_pdf(wo, wi)
+        let Some((wm, dg, pdf)) = self.distrib.reflection(wo, wi) else {
+            return (Vec3::ZERO, 0.0);
+        };
+        (self.fresnel.eval(wo.dot(wm)) * dg, pdf)
     }
 
     pub fn sample(&self, wo: Vec3, u: Vec2) -> Option<BsdfSample> {
@@ -83,9 +86,9 @@ impl Conductor {
         if wi.z <= 0.0 {
             return None;
         }
-        let pdf = self.pdf(wo, wi);
-        (pdf > 0.0).then(|| BsdfSample {
-            f: self.f(wo, wi),
+        let (f, pdf) = self.f_pdf(wo, wi);
+        (pdf > 0.0).then_some(BsdfSample {
+            f,
             wi,
             pdf,
             flags: BsdfFlags::REFLECTION.union(BsdfFlags::GLOSSY),

@@ -58,37 +58,38 @@ impl Dielectric {
     }
 
     pub fn f(&self, wo: Vec3, wi: Vec3) -> Vec3 {
-        if self.is_delta() {
-            return Vec3::ZERO;
-        }
-        let Some((wm, etap, reflect)) = self.half_vector(wo, wi) else {
-            return Vec3::ZERO;
-        };
-        let d = self.distrib.d(wm);
-        let g = self.distrib.g(wo, wi);
-        let fr = fresnel_dielectric(wo.dot(wm), self.eta);
-        if reflect {
-            Vec3::splat(d * g * fr / (4.0 * wo.z * wi.z).abs())
-        } else {
-            let denom = (wi.dot(wm) + wo.dot(wm) / etap).powi(2) * wi.z * wo.z;
-            self.tint * d * (1.0 - fr) * g * (wi.dot(wm) * wo.dot(wm) / denom).abs() / (etap * etap)
-        }
+        self.f_pdf(wo, wi).0
     }
 
     pub fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
+        self.f_pdf(wo, wi).1
+    }
+
+    /// [`Self::f`] and [`Self::pdf`] at once: one half vector, one D, one Λ(ωo) and one
+    /// Fresnel term for both.
+    pub fn f_pdf(&self, wo: Vec3, wi: Vec3) -> (Vec3, f32) {
         if self.is_delta() {
-            return 0.0;
+            return (Vec3::ZERO, 0.0);
         }
         let Some((wm, etap, reflect)) = self.half_vector(wo, wi) else {
-            return 0.0;
+            return (Vec3::ZERO, 0.0);
         };
-        let r = fresnel_dielectric(wo.dot(wm), self.eta);
-        let dv = self.distrib.d_visible(wo, wm);
+        let t = self.distrib.pair(wo, wi, wm);
+        let (d, g) = (t.d, t.g());
+        let fr = fresnel_dielectric(wo.dot(wm), self.eta);
+        let dv = t.d_visible(wo, wm);
         if reflect {
-            dv / (4.0 * wo.dot(wm).abs()) * r
+            let f = Vec3::splat(d * g * fr / (4.0 * wo.z * wi.z).abs());
+            (f, dv / (4.0 * wo.dot(wm).abs()) * fr)
         } else {
             let denom = (wi.dot(wm) + wo.dot(wm) / etap).powi(2);
-            dv * wi.dot(wm).abs() / denom * (1.0 - r)
+            let f = self.tint
+                * d
+                * (1.0 - fr)
+                * g
+                * (wi.dot(wm) * wo.dot(wm) / (denom * wi.z * wo.z)).abs()
+                / (etap * etap);
+            (f, dv * wi.dot(wm).abs() / denom * (1.0 - fr))
         }
     }
 
@@ -111,9 +112,9 @@ impl Dielectric {
             }
             (wi, BsdfFlags::TRANSMISSION)
         };
-        let pdf = self.pdf(wo, wi);
-        (pdf > 0.0).then(|| BsdfSample {
-            f: self.f(wo, wi),
+        let (f, pdf) = self.f_pdf(wo, wi);
+        (pdf > 0.0).then_some(BsdfSample {
+            f,
             wi,
             pdf,
             flags: flags.union(BsdfFlags::GLOSSY),

@@ -57,25 +57,30 @@ impl MetalRough {
     }
 
     pub fn f(&self, wo: Vec3, wi: Vec3) -> Vec3 {
+        self.f_pdf(wo, wi).0
+    }
+
+    pub fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
+        self.f_pdf(wo, wi).1
+    }
+
+    /// [`Self::f`] and [`Self::pdf`] at once: one half vector, one D and one Λ(ωo) for
+    /// both.
+    pub fn f_pdf(&self, wo: Vec3, wi: Vec3) -> (Vec3, f32) {
         if wo.z <= 0.0 || wi.z <= 0.0 {
-            return Vec3::ZERO;
+            return (Vec3::ZERO, 0.0);
         }
-        let Some((wm, dg)) = self.distrib.reflection(wo, wi) else {
-            return Vec3::ZERO;
+        let ps = self.specular_probability(wo.z);
+        let diffuse_pdf = (1.0 - ps) * cosine_hemisphere_pdf(wi.z);
+        let Some((wm, dg, specular_pdf)) = self.distrib.reflection(wo, wi) else {
+            return (Vec3::ZERO, ps * 0.0 + diffuse_pdf);
         };
         let f0 = self.f0();
         let spec = fresnel_schlick(f0, wo.dot(wm)) * dg;
         let transmit =
             (Vec3::ONE - fresnel_schlick(f0, wo.z)) * (Vec3::ONE - fresnel_schlick(f0, wi.z));
-        spec + transmit * self.diffuse_color() * FRAC_1_PI
-    }
-
-    pub fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
-        if wo.z <= 0.0 || wi.z <= 0.0 {
-            return 0.0;
-        }
-        let ps = self.specular_probability(wo.z);
-        ps * self.distrib.reflection_pdf(wo, wi) + (1.0 - ps) * cosine_hemisphere_pdf(wi.z)
+        let f = spec + transmit * self.diffuse_color() * FRAC_1_PI;
+        (f, ps * specular_pdf + diffuse_pdf)
     }
 
     pub fn sample(&self, wo: Vec3, u_lobe: f32, u: Vec2) -> Option<BsdfSample> {
@@ -91,14 +96,14 @@ impl MetalRough {
         if wi.z <= 0.0 {
             return None;
         }
-        let pdf = self.pdf(wo, wi);
+        let (f, pdf) = self.f_pdf(wo, wi);
         let flags = if u_lobe < ps {
             BsdfFlags::GLOSSY
         } else {
             BsdfFlags::DIFFUSE
         };
-        (pdf > 0.0).then(|| BsdfSample {
-            f: self.f(wo, wi),
+        (pdf > 0.0).then_some(BsdfSample {
+            f,
             wi,
             pdf,
             flags: BsdfFlags::REFLECTION.union(flags),

@@ -44,34 +44,38 @@ pub trait MicrofacetDistribution {
 
     /// Masking of one direction, G₁(ω) = 1/(1 + Λ(ω)).
     fn g1(&self, w: Vec3) -> f32 {
-        1.0 / (1.0 + self.lambda(w))
+        g1_of(self.lambda(w))
     }
 
     /// Height-correlated masking-shadowing G(ωo, ωi) = 1/(1 + Λ(ωo) + Λ(ωi)).
     fn g(&self, wo: Vec3, wi: Vec3) -> f32 {
-        1.0 / (1.0 + self.lambda(wo) + self.lambda(wi))
+        g_of(self.lambda(wo), self.lambda(wi))
     }
 
-    /// D(ωm) G(ωo, ωi) / (4 cos θo cos θi) of a reflection pair, with its half vector
-    /// ωm = (ωo + ωi)/|ωo + ωi|: the Torrance–Sparrow BRDF but for its Fresnel factor,
-    /// which is the caller's (of ωo·ωm). `None` where ωo + ωi vanishes.
-    fn reflection(&self, wo: Vec3, wi: Vec3) -> Option<(Vec3, f32)> {
+    /// D(ωm), Λ(ωo) and Λ(ωi) of a pair of directions about the normal `wm`: all that a
+    /// microfacet BSDF's value and its pdf ask of the distribution, computed once for both
+    /// (Beckmann's Λ costs an erfc and three exponentials).
+    fn pair(&self, wo: Vec3, wi: Vec3, wm: Vec3) -> PairTerms {
+        PairTerms {
+            d: self.d(wm),
+            lambda_o: self.lambda(wo),
+            lambda_i: self.lambda(wi),
+        }
+    }
+
+    /// For a reflection pair, with its half vector ωm = (ωo + ωi)/|ωo + ωi|: ωm, then
+    /// D(ωm) G(ωo, ωi) / (4 cos θo cos θi), the Torrance–Sparrow BRDF but for its Fresnel
+    /// factor, which is the caller's (of ωo·ωm), then the density of ωi = reflect(ωo, ωm)
+    /// for ωm sampled by [`Self::sample_wm`] from ωo: D_ω(ωm)/(4 |ωo·ωm|), 1/(4 |ωo·ωm|)
+    /// being the reflection's Jacobian dωm/dωi. `None` where ωo + ωi vanishes.
+    fn reflection(&self, wo: Vec3, wi: Vec3) -> Option<(Vec3, f32, f32)> {
         let wm = (wo + wi).normalize_or_zero();
         if wm == Vec3::ZERO {
             return None;
         }
-        Some((wm, self.d(wm) * self.g(wo, wi) / (4.0 * wo.z * wi.z)))
-    }
-
-    /// Density of ωi = reflect(ωo, ωm) for ωm sampled by [`Self::sample_wm`] from ωo:
-    /// D_ω(ωm)/(4 |ωo·ωm|) at the half vector, 1/(4 |ωo·ωm|) being the reflection's
-    /// Jacobian dωm/dωi. 0 where ωo + ωi vanishes.
-    fn reflection_pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
-        let wm = (wo + wi).normalize_or_zero();
-        if wm == Vec3::ZERO {
-            return 0.0;
-        }
-        self.d_visible(wo, wm) / (4.0 * wo.dot(wm).abs())
+        let t = self.pair(wo, wi, wm);
+        let dg = t.d * t.g() / (4.0 * wo.z * wi.z);
+        Some((wm, dg, t.d_visible(wo, wm) / (4.0 * wo.dot(wm).abs())))
     }
 
     /// Density of visible normals from `w`: G₁(ω)/|cos θ| · D(ωm) · |ω·ωm| (Heitz 2014,
@@ -80,11 +84,56 @@ pub trait MicrofacetDistribution {
     /// −`w`, so a normal is visible where ω·ωm has the sign of cos θ. Integrates to 1
     /// over ωm from either side.
     fn d_visible(&self, w: Vec3, wm: Vec3) -> f32 {
-        if w.z == 0.0 {
-            return 0.0;
-        }
-        let cos_m = w.dot(wm) * w.z.signum();
-        self.g1(w) / w.z.abs() * self.d(wm) * cos_m.max(0.0)
+        visible_density(w, wm, self.g1(w), self.d(wm))
+    }
+}
+
+/// G₁ = 1/(1 + Λ).
+#[inline(always)]
+fn g1_of(lambda: f32) -> f32 {
+    1.0 / (1.0 + lambda)
+}
+
+/// G = 1/(1 + Λ(ωo) + Λ(ωi)).
+#[inline(always)]
+fn g_of(lambda_o: f32, lambda_i: f32) -> f32 {
+    1.0 / (1.0 + lambda_o + lambda_i)
+}
+
+/// [`MicrofacetDistribution::d_visible`] from G₁(ω) and D(ωm).
+#[inline(always)]
+fn visible_density(w: Vec3, wm: Vec3, g1: f32, d: f32) -> f32 {
+    if w.z == 0.0 {
+        return 0.0;
+    }
+    let cos_m = w.dot(wm) * w.z.signum();
+    g1 / w.z.abs() * d * cos_m.max(0.0)
+}
+
+/// [`MicrofacetDistribution::pair`]'s answer: what a microfacet BSDF's value and pdf share
+/// for one pair (ωo, ωi) about a normal ωm. Its methods give the same numbers as the
+/// distribution's own.
+#[derive(Clone, Copy, Debug)]
+pub struct PairTerms {
+    /// D(ωm).
+    pub d: f32,
+    /// Λ(ωo).
+    pub lambda_o: f32,
+    /// Λ(ωi).
+    pub lambda_i: f32,
+}
+
+impl PairTerms {
+    /// G(ωo, ωi), as [`MicrofacetDistribution::g`].
+    #[inline(always)]
+    pub fn g(&self) -> f32 {
+        g_of(self.lambda_o, self.lambda_i)
+    }
+
+    /// D_ωo(ωm), as [`MicrofacetDistribution::d_visible`] from `wo`.
+    #[inline(always)]
+    pub fn d_visible(&self, wo: Vec3, wm: Vec3) -> f32 {
+        visible_density(wo, wm, g1_of(self.lambda_o), self.d)
     }
 }
 
@@ -142,6 +191,9 @@ impl MicrofacetDistribution for Microfacet {
     }
     fn d_visible(&self, w: Vec3, wm: Vec3) -> f32 {
         dispatch!(self, m => m.d_visible(w, wm))
+    }
+    fn pair(&self, wo: Vec3, wi: Vec3, wm: Vec3) -> PairTerms {
+        dispatch!(self, m => m.pair(wo, wi, wm))
     }
 }
 
@@ -214,6 +266,49 @@ impl MicrofacetDistribution for TrowbridgeReitz {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// [`MicrofacetDistribution::pair`]'s G and D_ω, and [`MicrofacetDistribution::reflection`],
+    /// which the BSDFs use to evaluate f and pdf at once, are bit for bit the distribution's
+    /// own G, D_ω and D (so sharing them changes no image): both distributions, isotropic
+    /// and not, directions above, below and grazing.
+    #[test]
+    fn pair_terms_equal_the_separate_ones() {
+        let dirs = [
+            Vec3::new(0.3, -0.2, 0.9),
+            Vec3::new(-0.7, 0.1, 0.4),
+            Vec3::new(0.1, 0.8, -0.3),
+            Vec3::new(0.5, 0.5, 0.02),
+            Vec3::Z,
+        ]
+        .map(Vec3::normalize);
+        let mut checked = 0;
+        for m in [
+            Microfacet::ggx(0.2, 0.2),
+            Microfacet::ggx(0.5, 0.1),
+            Microfacet::beckmann(0.2, 0.2),
+            Microfacet::beckmann(0.1, 0.6),
+        ] {
+            for wo in dirs {
+                for wi in dirs {
+                    let wm = (wo + wi).normalize_or_zero();
+                    let t = m.pair(wo, wi, wm);
+                    assert_eq!(t.d.to_bits(), m.d(wm).to_bits());
+                    assert_eq!(t.g().to_bits(), m.g(wo, wi).to_bits(), "{m:?} {wo} {wi}");
+                    let dv = m.d_visible(wo, wm);
+                    assert_eq!(t.d_visible(wo, wm).to_bits(), dv.to_bits());
+                    if let Some((h, dg, pdf)) = m.reflection(wo, wi) {
+                        assert_eq!(h, wm);
+                        let want = m.d(wm) * m.g(wo, wi) / (4.0 * wo.z * wi.z);
+                        assert_eq!(dg.to_bits(), want.to_bits());
+                        let want = dv / (4.0 * wo.dot(wm).abs());
+                        assert_eq!(pdf.to_bits(), want.to_bits());
+                        checked += usize::from(pdf > 0.0 && dg > 0.0);
+                    }
+                }
+            }
+        }
+        assert!(checked >= 30, "{checked}");
+    }
 
     /// ∫ D(ωm) cos θm dωm = 1 and ∫ D_ω(ωm) dωm = 1 for both distributions, by a midpoint
     /// rule in (θ, φ) (4000 × 256 cells; the narrowest lobe, α = 0.05, spans ~130 rows).

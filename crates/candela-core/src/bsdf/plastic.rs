@@ -98,21 +98,22 @@ impl Plastic {
         }
     }
 
-    /// Probability of choosing the coat's reflection when sampling from `wo`: its share
+    /// Probability of choosing the coat's reflection when sampling from `wo`, of coat
+    /// transmittance `t_o` ([`Self::coat_transmittance`] of its cosine): the coat's share
     /// of the albedo, each part's estimated by its brightest channel.
-    fn specular_probability(&self, cos_o: f32) -> f32 {
-        let t = self.coat_transmittance(cos_o);
-        let specular = (1.0 - t) * self.specular.max_element();
-        let diffuse = t * self.albedo.max_element().min(1.0);
+    fn specular_probability(&self, t_o: f32) -> f32 {
+        let specular = (1.0 - t_o) * self.specular.max_element();
+        let diffuse = t_o * self.albedo.max_element().min(1.0);
         if specular + diffuse <= 0.0 {
             return 1.0;
         }
         specular / (specular + diffuse)
     }
 
-    /// The base's term: T(θo) T(θi) ρ / (π η² (1 − ρ F_dr,in)), or its linear form.
-    fn diffuse_f(&self, wo: Vec3, wi: Vec3) -> Vec3 {
-        let t = self.coat_transmittance(wo.z) * self.coat_transmittance(wi.z);
+    /// The base's term: T(θo) T(θi) ρ / (π η² (1 − ρ F_dr,in)), or its linear form, from
+    /// T(θo) = `t_o`.
+    fn diffuse_f(&self, t_o: f32, wi: Vec3) -> Vec3 {
+        let t = t_o * self.coat_transmittance(wi.z);
         let denom = if self.linear {
             Vec3::splat(1.0 - self.fdr_inside)
         } else {
@@ -121,43 +122,47 @@ impl Plastic {
         self.albedo * (t * FRAC_1_PI / (self.eta * self.eta)) / denom
     }
 
-    /// The rough coat's reflection: F(ωo·ωm) D(ωm) G(ωo, ωi) / (4 cos θo cos θi).
-    fn coat_f(&self, wo: Vec3, wi: Vec3) -> f32 {
-        match self.distrib.reflection(wo, wi) {
-            Some((wm, dg)) => fresnel_dielectric(wo.dot(wm), self.eta) * dg,
-            None => 0.0,
-        }
-    }
-
     /// The non-delta part: the base, and a rough coat's reflection.
     pub fn f(&self, wo: Vec3, wi: Vec3) -> Vec3 {
-        if wo.z <= 0.0 || wi.z <= 0.0 {
-            return Vec3::ZERO;
-        }
-        let base = self.diffuse_f(wo, wi);
-        if self.is_smooth() {
-            return base;
-        }
-        base + self.specular * self.coat_f(wo, wi)
+        self.f_pdf(wo, wi).0
     }
 
     pub fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
+        self.f_pdf(wo, wi).1
+    }
+
+    /// [`Self::f`] and [`Self::pdf`] at once: one T(θo), and for a rough coat one half
+    /// vector, D and Λ(ωo), for both.
+    pub fn f_pdf(&self, wo: Vec3, wi: Vec3) -> (Vec3, f32) {
         if wo.z <= 0.0 || wi.z <= 0.0 {
-            return 0.0;
+            return (Vec3::ZERO, 0.0);
         }
-        let ps = self.specular_probability(wo.z);
+        let t_o = self.coat_transmittance(wo.z);
+        self.f_pdf_from(t_o, self.specular_probability(t_o), wo, wi)
+    }
+
+    /// [`Self::f_pdf`] of a pair in the upper hemisphere, given T(θo) = `t_o` and the
+    /// coat's sampling probability `ps` from `wo`.
+    fn f_pdf_from(&self, t_o: f32, ps: f32, wo: Vec3, wi: Vec3) -> (Vec3, f32) {
+        let base = self.diffuse_f(t_o, wi);
         let diffuse = (1.0 - ps) * cosine_hemisphere_pdf(wi.z);
         if self.is_smooth() {
-            return diffuse;
+            return (base, diffuse);
         }
-        diffuse + ps * self.distrib.reflection_pdf(wo, wi)
+        // The rough coat's reflection: F(ωo·ωm) D(ωm) G(ωo, ωi) / (4 cos θo cos θi).
+        let (coat_f, coat_pdf) = match self.distrib.reflection(wo, wi) {
+            Some((wm, dg, pdf)) => (fresnel_dielectric(wo.dot(wm), self.eta) * dg, pdf),
+            None => (0.0, 0.0),
+        };
+        (base + self.specular * coat_f, diffuse + ps * coat_pdf)
     }
 
     pub fn sample(&self, wo: Vec3, u_lobe: f32, u: Vec2) -> Option<BsdfSample> {
         if wo.z <= 0.0 {
             return None;
         }
-        let ps = self.specular_probability(wo.z);
+        let t_o = self.coat_transmittance(wo.z);
+        let ps = self.specular_probability(t_o);
         let coat = u_lobe < ps;
         if coat && self.is_smooth() {
             let wi = Vec3::new(-wo.x, -wo.y, wo.z);
@@ -178,9 +183,9 @@ impl Plastic {
         if wi.z <= 0.0 {
             return None;
         }
-        let pdf = self.pdf(wo, wi);
-        (pdf > 0.0).then(|| BsdfSample {
-            f: self.f(wo, wi),
+        let (f, pdf) = self.f_pdf_from(t_o, ps, wo, wi);
+        (pdf > 0.0).then_some(BsdfSample {
+            f,
             wi,
             pdf,
             flags: BsdfFlags::REFLECTION.union(kind),
