@@ -88,14 +88,14 @@ impl LightBounds {
 /// the box's bounding sphere and sin θ_o.
 #[derive(Clone, Copy, Debug)]
 pub struct ImportanceBounds {
-    pub(super) center: Vec3,
-    pub(super) radius: f32,
-    pub(super) w: Vec3,
-    pub(super) intensity: f32,
-    pub(super) cos_theta_o: f32,
-    pub(super) sin_theta_o: f32,
-    pub(super) cos_theta_e: f32,
-    pub(super) two_sided: bool,
+    pub(crate) center: Vec3,
+    pub(crate) radius: f32,
+    pub(crate) w: Vec3,
+    pub(crate) intensity: f32,
+    pub(crate) cos_theta_o: f32,
+    pub(crate) sin_theta_o: f32,
+    pub(crate) cos_theta_e: f32,
+    pub(crate) two_sided: bool,
 }
 
 impl ImportanceBounds {

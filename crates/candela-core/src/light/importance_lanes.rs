@@ -94,7 +94,7 @@ impl ImportanceLanes {
     }
 
     /// [`Self::importance`] in AVX2; inlined into AVX2 callers that evaluate several
-    /// lanes at one point (the light BVH's descent), which then splat the point once.
+    /// lanes at one point, which then splat the point once.
     ///
     /// # Safety
     ///
@@ -106,6 +106,53 @@ impl ImportanceLanes {
         // SAFETY (loads): every array is LANES f32 in a 32-byte aligned struct, at offsets
         // that are multiples of 32.
         let load = |a: &[f32; LANES]| unsafe { _mm256_load_ps(a.as_ptr()) };
+        let lanes = LoadedLanes {
+            center: [
+                load(&self.center[0]),
+                load(&self.center[1]),
+                load(&self.center[2]),
+            ],
+            radius: load(&self.radius),
+            w: [load(&self.w[0]), load(&self.w[1]), load(&self.w[2])],
+            intensity: load(&self.intensity),
+            cos_theta_o: load(&self.cos_theta_o),
+            sin_theta_o: load(&self.sin_theta_o),
+            cos_theta_e: load(&self.cos_theta_e),
+            // SAFETY: as the loads above.
+            two_sided: unsafe { _mm256_load_ps(self.two_sided.as_ptr() as *const f32) },
+        };
+        lanes.importance(ctx)
+    }
+}
+
+/// Eight [`ImportanceBounds`] field by field in AVX2 registers: what
+/// [`ImportanceLanes::importance_avx2`] evaluates, and what other layouts of bounds (the
+/// light BVH's blocks) load theirs into.
+#[cfg(target_arch = "x86_64")]
+#[derive(Clone, Copy)]
+pub struct LoadedLanes {
+    pub center: [__m256; 3],
+    pub radius: __m256,
+    pub w: [__m256; 3],
+    pub intensity: __m256,
+    pub cos_theta_o: __m256,
+    pub sin_theta_o: __m256,
+    pub cos_theta_e: __m256,
+    /// Two-sided where the sign bit is set (a blend mask).
+    pub two_sided: __m256,
+}
+
+#[cfg(target_arch = "x86_64")]
+impl LoadedLanes {
+    /// Each lane's [`ImportanceBounds::importance`] at `ctx`, bit for bit; inlined into
+    /// AVX2 callers.
+    ///
+    /// # Safety
+    ///
+    /// The CPU must have AVX2.
+    #[target_feature(enable = "avx,avx2")]
+    #[inline]
+    pub fn importance(&self, ctx: &ShadingCtx) -> [f32; LANES] {
         let splat = _mm256_set1_ps;
         let (zero, one) = (_mm256_setzero_ps(), splat(1.0));
         let select = |mask: __m256, yes: __m256, no: __m256| _mm256_blendv_ps(no, yes, mask);
@@ -129,9 +176,9 @@ impl ImportanceLanes {
         };
 
         let to = [
-            _mm256_sub_ps(splat(ctx.p.x), load(&self.center[0])),
-            _mm256_sub_ps(splat(ctx.p.y), load(&self.center[1])),
-            _mm256_sub_ps(splat(ctx.p.z), load(&self.center[2])),
+            _mm256_sub_ps(splat(ctx.p.x), self.center[0]),
+            _mm256_sub_ps(splat(ctx.p.y), self.center[1]),
+            _mm256_sub_ps(splat(ctx.p.z), self.center[2]),
         ];
         let d2 = dot(to, to);
         let positive = _mm256_cmp_ps::<_CMP_GT_OQ>(d2, zero);
@@ -141,24 +188,21 @@ impl ImportanceLanes {
             select(positive, _mm256_mul_ps(to[1], inv_d), zero),
             select(positive, _mm256_mul_ps(to[2], inv_d), one),
         ];
-        let radius = load(&self.radius);
+        let radius = self.radius;
         let d2c = _mm256_max_ps(d2, radius);
-        let w = [load(&self.w[0]), load(&self.w[1]), load(&self.w[2])];
-        let cos_w = dot(w, wi);
-        // SAFETY: as the loads above.
-        let two_sided = unsafe { _mm256_load_ps(self.two_sided.as_ptr() as *const f32) };
-        let cos_w = select(two_sided, _mm256_andnot_ps(splat(-0.0), cos_w), cos_w);
+        let cos_w = dot(self.w, wi);
+        let cos_w = select(self.two_sided, _mm256_andnot_ps(splat(-0.0), cos_w), cos_w);
         let sin_w = safe_sqrt(one_minus_sq(cos_w));
         let inside = _mm256_cmp_ps::<_CMP_LE_OQ>(d2, _mm256_mul_ps(radius, radius));
         let sin_b_out = _mm256_mul_ps(radius, inv_d);
         let sin_b = select(inside, zero, sin_b_out);
         let cos_b = select(inside, splat(-1.0), safe_sqrt(one_minus_sq(sin_b_out)));
-        let (sin_o, cos_o) = (load(&self.sin_theta_o), load(&self.cos_theta_o));
+        let (sin_o, cos_o) = (self.sin_theta_o, self.cos_theta_o);
         let cos_x = cos_sub(sin_w, cos_w, sin_o, cos_o);
         let sin_x = sin_sub(sin_w, cos_w, sin_o, cos_o);
         let cos_p = cos_sub(sin_x, cos_x, sin_b, cos_b);
-        let refused = _mm256_cmp_ps::<_CMP_LT_OQ>(cos_p, load(&self.cos_theta_e));
-        let mut importance = _mm256_div_ps(_mm256_mul_ps(load(&self.intensity), cos_p), d2c);
+        let refused = _mm256_cmp_ps::<_CMP_LT_OQ>(cos_p, self.cos_theta_e);
+        let mut importance = _mm256_div_ps(_mm256_mul_ps(self.intensity, cos_p), d2c);
         if ctx.n != glam::Vec3::ZERO {
             let n = [splat(ctx.n.x), splat(ctx.n.y), splat(ctx.n.z)];
             let cos_i = _mm256_andnot_ps(splat(-0.0), dot(wi, n));

@@ -39,6 +39,8 @@ pub use directional::DirectionalLight;
 pub use emission_texture::EmissionTexture;
 pub use environment::{EnvironmentLight, EnvironmentMap, EnvironmentSampling};
 pub use goniometric::GoniometricLight;
+#[cfg(target_arch = "x86_64")]
+pub use importance_lanes::LoadedLanes;
 pub use importance_lanes::{ImportanceLanes, LANES};
 pub use infinite_importance::{InfiniteImportance, SkyImportance, SkyIrradiance};
 pub use parallelogram::ParallelogramLight;

@@ -51,7 +51,8 @@ struct Node {
 /// A light BVH over the bounded lights, plus the unbounded ones.
 #[derive(Clone, Debug, Default)]
 pub struct LightBvh {
-    /// The tree's shape; the bounds are in `flat` or `descent`.
+    /// The shape of a flat tree (see `flat`, which holds its bounds); empty where the
+    /// tree is descended (its shape is in `descent`'s links).
     nodes: Vec<TreeNode>,
     /// See [`Self::tree_probability`].
     p_tree: f32,
@@ -120,7 +121,7 @@ impl LightBvh {
         };
         let mut bvh = LightBvh {
             p_tree: Self::tree_probability(!items.is_empty(), infinite.len()),
-            nodes: Vec::with_capacity(2 * items.len()),
+            nodes: Vec::new(),
             infinite,
             infinite_importance,
             trails: vec![0; lights.len()],
@@ -162,6 +163,7 @@ impl LightBvh {
                 bvh.flat = Some(FlatLights::new(&ids, &leaf_bounds));
             } else {
                 bvh.descent = Some(Descent::new(&bvh.nodes, &bounds));
+                bvh.nodes = Vec::new();
             }
         }
         Some(bvh)
@@ -305,10 +307,6 @@ impl LightBvh {
             + 8 * self.trails.len()
             + self.flat.as_ref().map_or(0, FlatLights::memory_bytes)
             + self.descent.as_ref().map_or(0, Descent::memory_bytes)
-    }
-
-    pub fn node_count(&self) -> usize {
-        self.nodes.len()
     }
 }
 
@@ -491,21 +489,9 @@ mod tests {
             })
             .collect();
         let bvh = LightBvh::new(&lights).unwrap();
-        assert_eq!(bvh.node_count(), 2 * lights.len() - 1);
+        let descent = bvh.descent.as_ref().expect("more lights than FLAT_MAX");
         for (i, &trail) in bvh.trails.iter().enumerate() {
-            let depth = 63 - trail.leading_zeros();
-            let mut at = 0usize;
-            for level in 0..depth {
-                let node = &bvh.nodes[at];
-                assert!(!node.is_leaf);
-                at = if trail & (1 << level) == 0 {
-                    at + 1
-                } else {
-                    node.index as usize
-                };
-            }
-            assert!(bvh.nodes[at].is_leaf);
-            assert_eq!(bvh.nodes[at].index, i as u32);
+            assert_eq!(descent.light_at(trail), Some(i as u32));
         }
     }
 
