@@ -53,6 +53,24 @@ LIB_FN = re.compile(r"^(__[a-z0-9_]+|[a-z0-9]+|libm::.*|compiler_builtins::.*)$"
 DEBUG = False
 
 
+def resolve(names, kind, rest):
+    """The name a callgrind line `kind=rest` gives: `(id) text` defines id in the table of
+    its kind (files, functions, objects; `names` holds the three), `(id)` refers to it."""
+    m = re.match(r"\((\d+)\)(?: (.*))?", rest)
+    if not m:
+        return rest
+    table = names["fl" if kind in ("fl", "fi", "fe", "cfi", "cfl") else kind.lstrip("c")]
+    if m.group(2) is not None:
+        table[m.group(1)] = m.group(2)
+    return table.get(m.group(1), "?")
+
+
+def is_lib_name(ob, fl, fn):
+    """Whether code of object `ob`, file `fl`, function `fn` is a math-runtime leaf."""
+    return bool(LIB_OBJ.search(ob or "") or LIB_FILE.search(fl or "")
+                or LIB_FN.match(fn or ""))
+
+
 def split(path):
     others = defaultdict(int)
     names = {"fl": {}, "fn": {}, "ob": {}}
@@ -62,17 +80,7 @@ def split(path):
     pending_call = False
 
     def name(kind, rest):
-        m = re.match(r"\((\d+)\)(?: (.*))?", rest)
-        if not m:
-            return rest
-        table = names["fl" if kind in ("fl", "fi", "fe", "cfi", "cfl") else kind.lstrip("c")]
-        if m.group(2) is not None:
-            table[m.group(1)] = m.group(2)
-        return table.get(m.group(1), "?")
-
-    def is_lib(ob, fl, fn):
-        return bool(LIB_OBJ.search(ob or "") or LIB_FILE.search(fl or "")
-                    or LIB_FN.match(fn or ""))
+        return resolve(names, kind, rest)
 
     def here(v):
         f = cur["fi"] or cur["fl"]
@@ -101,11 +109,11 @@ def split(path):
                     target = (call_ob or cur["ob"], call_fl or "", call_fn)
                     call_ob = call_fl = call_fn = None
                     # A call's inclusive cost: a library leaf counts for its caller.
-                    if is_lib(*target):
-                        if not is_lib(cur["ob"], cur["fl"], cur["fn"]):
+                    if is_lib_name(*target):
+                        if not is_lib_name(cur["ob"], cur["fl"], cur["fn"]):
                             cost[here(v)] += v
                     continue
-                if is_lib(cur["ob"], cur["fl"], cur["fn"]):
+                if is_lib_name(cur["ob"], cur["fl"], cur["fn"]):
                     continue  # counted at the call site
                 cost[here(v)] += v
                 continue

@@ -212,8 +212,23 @@ impl Light {
 
     /// A direction towards the light, with the radiance arriving along it and its
     /// density; `None` unless the sample carries light with a positive, finite density.
-    #[inline]
+    ///
+    /// Point lights and spots, a few instructions of arithmetic, are sampled inline where
+    /// next event estimation calls this: out of line, the call, its saves and the sample
+    /// returned through memory (copied once more by the usability check) cost as much as
+    /// the light's own arithmetic (bench/RESULTS.md, shade: fourth round).
+    #[inline(always)]
     pub fn sample_li(&self, ctx: &ShadingCtx, u: Vec2) -> Option<LightSample> {
+        match self {
+            Light::Point(l) => l.sample_li(ctx, u)?.usable(),
+            Light::Spot(l) => l.sample_li(ctx, u)?.usable(),
+            _ => self.sample_li_out_of_line(ctx, u),
+        }
+    }
+
+    /// [`Self::sample_li`] of the other lights.
+    #[inline(never)]
+    fn sample_li_out_of_line(&self, ctx: &ShadingCtx, u: Vec2) -> Option<LightSample> {
         dispatch!(self, l => l.sample_li(ctx, u))?.usable()
     }
 

@@ -16,6 +16,7 @@ pub struct PointLight {
 impl LightSource for PointLight {
     const FLAGS: LightFlags = LightFlags::DELTA_POSITION;
 
+    #[inline]
     fn sample_li(&self, ctx: &ShadingCtx, _u: Vec2) -> Option<LightSample> {
         let to = self.position - ctx.p;
         let d2 = to.length_squared();

@@ -69,6 +69,7 @@ impl SpotLight {
     }
 
     /// f(θ) for x = cos θ.
+    #[inline]
     pub fn falloff_at(&self, cos_theta: f32) -> f32 {
         if cos_theta >= self.cos_inner {
             return 1.0;
@@ -88,6 +89,7 @@ impl SpotLight {
     }
 
     /// Radiant intensity (W/sr) towards the unit direction `w` leaving the light.
+    #[inline]
     pub fn intensity_towards(&self, w: Vec3) -> Vec3 {
         let f = self.falloff_at(w.dot(self.frame.n));
         if f == 0.0 {
@@ -208,6 +210,7 @@ impl SpotLight {
 impl LightSource for SpotLight {
     const FLAGS: LightFlags = LightFlags::DELTA_POSITION;
 
+    #[inline]
     fn sample_li(&self, ctx: &ShadingCtx, _u: Vec2) -> Option<LightSample> {
         positional::sample_li(self.position, ctx, |w| self.intensity_towards(w))
     }

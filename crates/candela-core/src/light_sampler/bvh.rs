@@ -17,9 +17,9 @@
 use rayon::join;
 
 use super::descent::{Descent, TreeNode};
+use super::flat::{positive_finite, FlatLights};
 use crate::light::{
-    cone_measure, ImportanceBounds, ImportanceLanes, InfiniteImportance, Light, LightBounds,
-    ShadingCtx,
+    cone_measure, ImportanceBounds, InfiniteImportance, Light, LightBounds, ShadingCtx, LANES,
 };
 use crate::sampling::ONE_MINUS_EPSILON;
 
@@ -35,7 +35,7 @@ const MAX_SAOH_DEPTH: u32 = 40;
 /// Trees of at most this many lights are sampled flat: every light by its own importance
 /// at the point, in one pass over the leaves, instead of a descent through clusters whose
 /// bounds blur their members' (see [`LightBvh::sample`]).
-pub const FLAT_MAX: usize = 8;
+pub const FLAT_MAX: usize = LANES;
 /// At most this many infinite lights are picked by their importance at the point (see
 /// [`LightBvh::new`]).
 const INFINITE_MAX: usize = 8;
@@ -51,8 +51,8 @@ struct Node {
 /// A light BVH over the bounded lights, plus the unbounded ones.
 #[derive(Clone, Debug, Default)]
 pub struct LightBvh {
-    /// The shape of a flat tree (see `flat`), whose bounds are in `flat_lanes`; empty
-    /// where the tree is descended (its shape is in `descent`'s links).
+    /// The shape of a flat tree (see `flat`, which holds its bounds); empty where the
+    /// tree is descended (its shape is in `descent`'s links).
     nodes: Vec<TreeNode>,
     /// See [`Self::tree_probability`].
     p_tree: f32,
@@ -64,11 +64,9 @@ pub struct LightBvh {
     /// Per light: the branch taken at each level (bit d = level d, 1 = second child),
     /// with a leading 1 marking the depth; 0 where the light is not in the tree.
     trails: Vec<u64>,
-    /// Where the tree has at most [`FLAT_MAX`] lights: its leaves' node indices, which
-    /// sampling weighs directly; empty otherwise.
-    flat: Vec<u32>,
-    /// The bounds of `flat`'s leaves in lanes, weighed at once.
-    flat_lanes: Option<Box<ImportanceLanes>>,
+    /// Where the tree has at most [`FLAT_MAX`] lights: its leaves, which sampling weighs
+    /// directly.
+    flat: Option<FlatLights>,
     /// Where the tree has more than [`FLAT_MAX`] lights: its nodes' bounds in the blocks
     /// that the descent evaluates two levels at a time.
     descent: Option<Descent>,
@@ -127,8 +125,7 @@ impl LightBvh {
             infinite,
             infinite_importance,
             trails: vec![0; lights.len()],
-            flat: Vec::new(),
-            flat_lanes: None,
+            flat: None,
             descent: None,
         };
         if !items.is_empty() {
@@ -157,12 +154,13 @@ impl LightBvh {
             bvh.set_trails();
             // A tree of n lights has 2n − 1 nodes.
             if bvh.nodes.len() < 2 * FLAT_MAX {
-                bvh.flat = (0..bvh.nodes.len() as u32)
-                    .filter(|&i| bvh.nodes[i as usize].is_leaf)
+                let leaves: Vec<usize> = (0..bvh.nodes.len())
+                    .filter(|&i| bvh.nodes[i].is_leaf)
                     .collect();
-                let leaves: Vec<ImportanceBounds> =
-                    bvh.flat.iter().map(|&i| bounds[i as usize]).collect();
-                bvh.flat_lanes = Some(Box::new(ImportanceLanes::new(&leaves)));
+                let ids: Vec<u32> = leaves.iter().map(|&i| bvh.nodes[i].index).collect();
+                let leaf_bounds: Vec<ImportanceBounds> =
+                    leaves.iter().map(|&i| bounds[i]).collect();
+                bvh.flat = Some(FlatLights::new(&ids, &leaf_bounds));
             } else {
                 bvh.descent = Some(Descent::new(&bvh.nodes, &bounds));
                 bvh.nodes = Vec::new();
@@ -196,7 +194,23 @@ impl LightBvh {
 
     /// A light and its probability at `ctx`; `None` where no light in the tree can reach
     /// the point (and there are no infinite lights).
-    pub fn sample(&self, ctx: &ShadingCtx, mut u: f32) -> Option<(u32, f32)> {
+    ///
+    /// A flat tree without infinite lights, most scenes' few lamps, is sampled here, inlined
+    /// into the caller (the render loop's AVX2 copy, which then inlines the lanes'
+    /// evaluation too); the rest out of line. There the tree is picked with probability 1
+    /// and `u` passes unchanged: the same numbers as [`Self::sample_general`]'s
+    /// `(u − 0) / 1` and `1 · p`.
+    #[inline]
+    pub fn sample(&self, ctx: &ShadingCtx, u: f32) -> Option<(u32, f32)> {
+        match &self.flat {
+            Some(flat) if self.infinite.is_empty() => flat.sample(ctx, u.min(ONE_MINUS_EPSILON)),
+            _ => self.sample_general(ctx, u),
+        }
+    }
+
+    /// [`Self::sample`] in general: an infinite light or the tree, then within the tree.
+    #[inline(never)]
+    fn sample_general(&self, ctx: &ShadingCtx, mut u: f32) -> Option<(u32, f32)> {
         let p_tree = self.p_tree();
         let p_inf = 1.0 - p_tree;
         if u < p_inf {
@@ -204,14 +218,26 @@ impl LightBvh {
             return Some((self.infinite[i], p_inf * p));
         }
         u = ((u - p_inf) / p_tree).min(ONE_MINUS_EPSILON);
-        if !self.flat.is_empty() {
-            return self.sample_flat(ctx, u).map(|(i, p)| (i, p_tree * p));
+        if let Some(flat) = &self.flat {
+            return flat.sample(ctx, u).map(|(i, p)| (i, p_tree * p));
         }
         self.descent.as_ref()?.sample(ctx, u, p_tree)
     }
 
-    /// Probability that [`Self::sample`] picks `light` at `ctx`.
+    /// Probability that [`Self::sample`] picks `light` at `ctx`; inlined for a flat tree
+    /// without infinite lights, as [`Self::sample`] (a light outside the tree gets 0 there
+    /// too: the flat pick does not hold it).
+    #[inline]
     pub fn pmf(&self, ctx: &ShadingCtx, light: u32) -> f32 {
+        match &self.flat {
+            Some(flat) if self.infinite.is_empty() => flat.pmf(ctx, light),
+            _ => self.pmf_general(ctx, light),
+        }
+    }
+
+    /// [`Self::pmf`] in general.
+    #[inline(never)]
+    fn pmf_general(&self, ctx: &ShadingCtx, light: u32) -> f32 {
         let trail = self.trails[light as usize];
         if trail == 0 {
             return match self.infinite.iter().position(|&l| l == light) {
@@ -219,66 +245,13 @@ impl LightBvh {
                 None => 0.0,
             };
         }
-        if !self.flat.is_empty() {
-            return self.p_tree() * self.flat_pmf(ctx, light);
+        if let Some(flat) = &self.flat {
+            return self.p_tree() * flat.pmf(ctx, light);
         }
         match &self.descent {
             Some(d) => d.pmf(ctx, trail, self.p_tree()),
             None => 0.0,
         }
-    }
-
-    /// The importances of the flat tree's leaves at `ctx` (in the order of `flat`) and
-    /// their sum.
-    #[inline]
-    fn flat_weights(&self, ctx: &ShadingCtx) -> ([f32; FLAT_MAX], f32) {
-        let w = match &self.flat_lanes {
-            // Every light's own importance, eight lights in one evaluation.
-            Some(lanes) => lanes.importance(ctx),
-            None => [0.0; FLAT_MAX],
-        };
-        let mut total = 0.0;
-        for &w in &w[..self.flat.len()] {
-            total += w;
-        }
-        (w, total)
-    }
-
-    /// A light of a flat tree in proportion to its importance at `ctx`, and its
-    /// probability among the tree's; `None` where none can reach the point. One light
-    /// by its own bounds, where the descent weighs clusters by bounds of their union:
-    /// the same cost up to FLAT_MAX lights (a descent evaluates two bounds per level),
-    /// and picks that follow each light rather than its cluster.
-    fn sample_flat(&self, ctx: &ShadingCtx, u: f32) -> Option<(u32, f32)> {
-        let (w, total) = self.flat_weights(ctx);
-        if !positive_finite(total) {
-            return None;
-        }
-        let target = u * total;
-        let mut acc = 0.0;
-        let mut last = None;
-        for (&w, &leaf) in w.iter().zip(&self.flat) {
-            if w > 0.0 {
-                last = Some((self.nodes[leaf as usize].index, w / total));
-                acc += w;
-                if target < acc {
-                    break;
-                }
-            }
-        }
-        last
-    }
-
-    /// Probability that [`Self::sample_flat`] picks `light` at `ctx`.
-    fn flat_pmf(&self, ctx: &ShadingCtx, light: u32) -> f32 {
-        let (w, total) = self.flat_weights(ctx);
-        if !positive_finite(total) {
-            return 0.0;
-        }
-        self.flat
-            .iter()
-            .position(|&leaf| self.nodes[leaf as usize].index == light)
-            .map_or(0.0, |k| w[k] / total)
     }
 
     /// The importances of the infinite lights at `ctx` (the first `infinite.len()`
@@ -332,18 +305,9 @@ impl LightBvh {
     pub fn memory_bytes(&self) -> usize {
         self.nodes.len() * std::mem::size_of::<TreeNode>()
             + 8 * self.trails.len()
-            + self
-                .flat_lanes
-                .as_ref()
-                .map_or(0, |_| size_of::<ImportanceLanes>())
+            + self.flat.as_ref().map_or(0, FlatLights::memory_bytes)
             + self.descent.as_ref().map_or(0, Descent::memory_bytes)
     }
-}
-
-/// Whether `x` is positive and finite (what a sum of weights must be to pick by it).
-#[inline(always)]
-fn positive_finite(x: f32) -> bool {
-    x > 0.0 && x < f32::INFINITY
 }
 
 /// SAOH cost of a cluster (pbrt-v4's `EvaluateCost`): intensity × orientation measure

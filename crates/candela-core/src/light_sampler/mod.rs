@@ -17,6 +17,7 @@
 mod array;
 mod bvh;
 mod descent;
+mod flat;
 pub mod ris;
 
 pub use array::LightArray;

@@ -13,6 +13,23 @@ use glam::Vec2;
 
 use crate::sampling::{sample_linear, ONE_MINUS_EPSILON};
 
+/// `n` as an `f32`: the value of `n as f32`, for the grid sizes here (below 2³²), by way
+/// of `u32`, whose conversion on x86-64 is one instruction where `usize`'s tests the sign
+/// bit and branches.
+#[inline(always)]
+fn size_f32(n: usize) -> f32 {
+    debug_assert!(u32::try_from(n).is_ok());
+    n as u32 as f32
+}
+
+/// `x as usize` for `x` below 2³² (the callers clamp it to a grid size; 0 for NaN and
+/// negatives, as `as usize`), by way of `u32`: on x86-64 half the instructions of the
+/// saturating conversion to `usize`, which also handles values past 2⁶³.
+#[inline(always)]
+pub(super) fn cell_index(x: f32) -> usize {
+    x as u32 as usize
+}
+
 /// Where the vertices of one axis of a [`Bilinear2D`] grid lie on [0, 1].
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum GridAxis {
@@ -37,14 +54,14 @@ impl GridAxis {
     #[inline]
     pub fn position(self, k: usize) -> f32 {
         match self {
-            GridAxis::Even(n) => k as f32 / n as f32,
+            GridAxis::Even(n) => size_f32(k) / size_f32(n),
             GridAxis::Centred(n) => {
                 if k == 0 {
                     0.0
                 } else if k > n {
                     1.0
                 } else {
-                    (k as f32 - 0.5) / n as f32
+                    (size_f32(k) - 0.5) / size_f32(n)
                 }
             }
         }
@@ -55,19 +72,19 @@ impl GridAxis {
     pub fn locate(self, x: f32) -> (usize, f32) {
         match self {
             GridAxis::Even(n) => {
-                let s = (x * n as f32).clamp(0.0, n as f32);
-                let k = (s as usize).min(n - 1);
-                (k, (s - k as f32).min(1.0))
+                let s = (x * size_f32(n)).clamp(0.0, size_f32(n));
+                let k = cell_index(s).min(n - 1);
+                (k, (s - size_f32(k)).min(1.0))
             }
             GridAxis::Centred(n) => {
-                let s = (x * n as f32 + 0.5).clamp(0.0, n as f32 + 1.0);
-                let k = (s as usize).min(n);
+                let s = (x * size_f32(n) + 0.5).clamp(0.0, size_f32(n) + 1.0);
+                let k = cell_index(s).min(n);
                 let t = if k == 0 {
                     2.0 * s - 1.0
                 } else if k == n {
-                    2.0 * (s - k as f32)
+                    2.0 * (s - size_f32(k))
                 } else {
-                    s - k as f32
+                    s - size_f32(k)
                 };
                 (k, t.clamp(0.0, 1.0))
             }
@@ -92,6 +109,10 @@ pub struct Bilinear2D {
     marginal_guide: Vec<u32>,
     /// Guides to each vertex row's `row_cdf`: `ROW_GUIDE + 1` entries a row.
     row_guides: Vec<u32>,
+    /// [`GridAxis::position`] of every vertex of each axis, looked up by the sampling
+    /// rather than computed (a match on the axis, a conversion and a division each).
+    x_positions: Vec<f32>,
+    y_positions: Vec<f32>,
     integral: f32,
 }
 
@@ -175,6 +196,7 @@ impl Bilinear2D {
             .chunks_exact(stride)
             .flat_map(|row| guide(row, ROW_GUIDE))
             .collect();
+        let positions = |axis: GridAxis| (0..axis.vertices()).map(|k| axis.position(k)).collect();
         Bilinear2D {
             x_axis,
             y_axis,
@@ -184,6 +206,8 @@ impl Bilinear2D {
             marginal_cdf,
             marginal_guide,
             row_guides,
+            x_positions: positions(x_axis),
+            y_positions: positions(y_axis),
             integral: acc as f32,
         }
     }
@@ -232,13 +256,13 @@ impl Bilinear2D {
         let target = u.y * self.integral;
         let m = &self.marginal_cdf;
         let cells = m.len() - 1;
-        let g = ((u.y * cells as f32) as usize).min(cells - 1);
+        let g = cell_index(u.y * size_f32(cells)).min(cells - 1);
         let (lo, hi) = (self.marginal_guide[g], self.marginal_guide[g + 1] + 1);
         let j = last_at_or_below(|j| m[j], target, cells, lo as usize, hi as usize);
         let xi = unit_within(m[j], m[j + 1], target);
         let row_integral = |j: usize| self.row_cdf[(j + 1) * self.stride - 1];
         let t = sample_linear(xi, row_integral(j), row_integral(j + 1));
-        let (y0, y1) = (self.y_axis.position(j), self.y_axis.position(j + 1));
+        let (y0, y1) = (self.y_positions[j], self.y_positions[j + 1]);
         let y = (y0 + t * (y1 - y0)).min(ONE_MINUS_EPSILON);
 
         // The column cell, from f(·, y)'s running integral: the blend of the two vertex
@@ -248,7 +272,7 @@ impl Bilinear2D {
         let cdf = |k: usize| top[k] + t * (bottom[k] - top[k]);
         let cells = self.stride - 1;
         let target = u.x * cdf(cells);
-        let g = ((u.x * ROW_GUIDE as f32) as usize).min(ROW_GUIDE - 1);
+        let g = cell_index(u.x * ROW_GUIDE as f32).min(ROW_GUIDE - 1);
         let guides = &self.row_guides[j * (ROW_GUIDE + 1)..(j + 2) * (ROW_GUIDE + 1)];
         let (top_guide, bottom_guide) = guides.split_at(ROW_GUIDE + 1);
         let lo = top_guide[g].min(bottom_guide[g]) as usize;
@@ -260,7 +284,7 @@ impl Bilinear2D {
         let f0 = v[i] + t * (v[i + self.stride] - v[i]);
         let f1 = v[i + 1] + t * (v[i + self.stride + 1] - v[i + 1]);
         let s = sample_linear(xi, f0, f1);
-        let (x0, x1) = (self.x_axis.position(k), self.x_axis.position(k + 1));
+        let (x0, x1) = (self.x_positions[k], self.x_positions[k + 1]);
         let x = (x0 + s * (x1 - x0)).min(ONE_MINUS_EPSILON);
         let f = f0 + s * (f1 - f0);
         (f > 0.0).then(|| (Vec2::new(x, y), f / self.integral))

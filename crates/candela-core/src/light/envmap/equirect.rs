@@ -27,6 +27,8 @@ pub struct Equirect {
     grid: Vec<Vec4>,
     /// Boxed, to keep [`crate::light::Light`] small.
     distribution: Box<Bilinear2D>,
+    /// Half a texel's width in u, 0.5 / width: where the grid's columns start.
+    half_texel: f32,
 }
 
 /// Image coordinates (u right, v down, both in [0,1]) of a unit direction.
@@ -104,6 +106,7 @@ impl Equirect {
             y_axis,
         ));
         Equirect {
+            half_texel: 0.5 / w as f32,
             image,
             grid,
             distribution,
@@ -113,7 +116,7 @@ impl Equirect {
     /// The grid's coordinates of `uv`: columns start half a texel to the right of u = 0.
     #[inline]
     fn grid_point(&self, uv: Vec2) -> Vec2 {
-        let x = uv.x - 0.5 / self.image.width as f32;
+        let x = uv.x - self.half_texel;
         Vec2::new(if x < 0.0 { x + 1.0 } else { x }, uv.y)
     }
 
@@ -153,7 +156,7 @@ impl Equirect {
     /// approximation of it): see [`Equirect`].
     pub fn sample(&self, u: Vec2) -> Option<MapSample> {
         let (p, pdf_grid) = self.distribution.sample(u)?;
-        let x = p.x + 0.5 / self.image.width as f32;
+        let x = p.x + self.half_texel;
         let uv = Vec2::new(if x >= 1.0 { x - 1.0 } else { x }, p.y);
         let (dir, sin_theta) = uv_to_direction_sin(uv);
         if sin_theta <= 0.0 {
