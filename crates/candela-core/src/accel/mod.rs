@@ -23,6 +23,7 @@
 //! [`LeafLayout::auto`] chooses them for big scenes). Every layout finds the same hits.
 
 mod block;
+mod coherent;
 mod geometry;
 mod indexed;
 mod lanes;
