@@ -76,7 +76,6 @@ mod x86 {
     use crate::accel::block::{Best8, Block, Rays8};
     use crate::accel::small::{nearest, SmallTree};
     use crate::bvh::{Avx2Boxes, BoxTest, Node8, Ray8, T_MAX_SCALE};
-    use crate::geometry::WatertightRay;
     use std::arch::x86_64::*;
 
     /// The packet query of a tree of one node.
@@ -92,23 +91,17 @@ mod x86 {
         t_max: &[f32; 8],
         filter: &impl Fn(usize, u32, &TriangleHit) -> bool,
     ) -> [Option<Hit>; 8] {
-        let mut packet = Rays8::new(rays);
-        let mut boxes = RootBoxes::default();
+        let (packet, finite) = Rays8::new(rays);
         // Rays that are not finite find nothing, as in the single query.
-        let mut live = 0;
-        let mut rest = active;
-        while rest != 0 {
-            let i = rest.trailing_zeros() as usize;
-            rest &= rest - 1;
-            let r8 = Ray8::new(&rays[i]);
-            if !r8.finite {
-                continue;
-            }
-            live |= 1 << i;
-            packet.set(i, &WatertightRay::from_recip(&rays[i], r8.inv_d));
-            if let Some(root) = &small.root {
+        let live = active & finite;
+        let mut boxes = RootBoxes::default();
+        if let Some(root) = &small.root {
+            let mut rest = live;
+            while rest != 0 {
+                let i = rest.trailing_zeros() as usize;
+                rest &= rest - 1;
                 // The root's box test, as `root_query` makes it.
-                let prepared = Avx2Boxes::prepare(&r8);
+                let prepared = Avx2Boxes::prepare(&Ray8::new(&rays[i]));
                 let t_box = t_max[i] * T_MAX_SCALE;
                 (boxes.mask[i], boxes.t_near[i]) = Avx2Boxes::hit8(&prepared, &root.planes, t_box);
             }
