@@ -322,13 +322,16 @@ enum Event {
 struct Recorder {
     inner: IndependentSampler,
     dimension: u32,
+    /// The log's entry of this clone's current pixel sample: the render loop keeps a
+    /// clone a sample of a camera packet, whose requests interleave in time.
+    entry: usize,
     log: Arc<std::sync::Mutex<Vec<Vec<Event>>>>,
 }
 
 impl Recorder {
     fn push(&mut self, event: fn(u32) -> Event, width: u32) {
         let mut log = self.log.lock().unwrap();
-        log.last_mut().unwrap().push(event(self.dimension));
+        log[self.entry].push(event(self.dimension));
         self.dimension += width;
     }
 }
@@ -337,7 +340,9 @@ impl Sampler for Recorder {
     fn start_pixel_sample(&mut self, pixel: UVec2, index: u32) {
         self.inner.start_pixel_sample(pixel, index);
         self.dimension = 0;
-        self.log.lock().unwrap().push(Vec::new());
+        let mut log = self.log.lock().unwrap();
+        self.entry = log.len();
+        log.push(Vec::new());
     }
     fn get_1d(&mut self) -> f32 {
         self.push(Event::OneD, 1);
@@ -375,11 +380,12 @@ fn the_integrator_takes_the_first_direction_at_that_dimension() {
         let recorder = Recorder {
             inner: IndependentSampler::new(1),
             dimension: 0,
+            entry: 0,
             log: log.clone(),
         };
         let cancel = AtomicBool::new(false);
-        // One worker: every clone of the recorder appends to the log's last entry, so two
-        // threads would interleave their samples' requests.
+        // One worker: each clone of the recorder appends to its pixel sample's entry,
+        // which two threads would still log in an order of their own.
         let pool = rayon::ThreadPoolBuilder::new()
             .num_threads(1)
             .build()

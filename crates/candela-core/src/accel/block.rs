@@ -13,6 +13,9 @@
 //! and everything under [`Simd::Scalar`] goes lane by lane: the reference the tests
 //! compare the vector paths against.
 
+#[cfg(target_arch = "x86_64")]
+mod rays8;
+
 use glam::Vec3;
 
 #[cfg(target_arch = "x86_64")]
@@ -22,6 +25,9 @@ use super::sphere;
 #[cfg(doc)]
 use crate::bvh::Simd;
 use crate::geometry::{intersect_sphere, Ray, TriangleHit, WatertightRay};
+
+#[cfg(target_arch = "x86_64")]
+pub(crate) use rays8::{Best8, Rays8};
 
 pub const SPHERE: u32 = 1 << 31;
 pub const FILTERED: u32 = 1 << 30;

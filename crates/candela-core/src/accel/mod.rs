@@ -17,12 +17,18 @@
 //! where the CPU has them, else SSE; [`Accel::build_for`] forces one (the tests run each the CPU has
 //! against the scalar one). Every kernel finds the same hits, bit for bit.
 //!
+//! Camera rays are traced eight at a time where the tree is one node ([`coherent`]:
+//! each block against the eight rays in lanes, every ray's hit that of
+//! [`Accel::intersect`] bit for bit); [`packet`] is the measured packet traversal of
+//! deeper trees, which the renderer does not use.
+//!
 //! [`AccelLayout`] picks the wide nodes, full planes (the default) or quantized boxes
 //! (half the node memory), and the leaves: inline blocks (the default) or indexed
 //! records gathered into a block when a ray reaches them (a quarter of the memory;
 //! [`LeafLayout::auto`] chooses them for big scenes). Every layout finds the same hits.
 
 mod block;
+mod coherent;
 mod geometry;
 mod indexed;
 mod lanes;

@@ -3,6 +3,8 @@
 //! A measured kernel for the `traversal` benchmark (issue #35's packet rung), not used by
 //! the renderer: on incoherent rays it costs more than eight single-ray queries, on
 //! coherent camera rays about 10 % less (figures in `bench/RESULTS.md`, `## traversal`).
+//! The renderer's camera packets are [`super::coherent`]'s (trees of one node, leaves
+//! tested eight rays at a time).
 
 use std::cell::Cell;
 

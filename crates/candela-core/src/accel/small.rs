@@ -38,8 +38,8 @@ pub(super) struct SmallTree {
 /// primitive count.
 #[derive(Clone, Copy, Debug)]
 pub(super) struct SoleLeaf {
-    leaf: u32,
-    count: u32,
+    pub(super) leaf: u32,
+    pub(super) count: u32,
 }
 
 impl SmallTree {
@@ -278,7 +278,7 @@ where
 /// The lane of `mask` with the least `t` (never NaN: the box test's entry distances),
 /// the highest among equals.
 #[inline(always)]
-fn nearest(mask: u32, t: &[f32; 8]) -> usize {
+pub(super) fn nearest(mask: u32, t: &[f32; 8]) -> usize {
     let mut rest = mask;
     let mut best = rest.trailing_zeros() as usize;
     rest &= rest - 1;

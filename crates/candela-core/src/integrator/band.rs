@@ -6,7 +6,7 @@ use std::ops::Range;
 
 use glam::{UVec2, Vec2, Vec3};
 
-use super::path::li;
+use super::path::{li, li_from_hit};
 use super::RenderStats;
 use crate::filter::PixelFilter;
 use crate::geometry::Ray;
@@ -60,7 +60,8 @@ pub(crate) fn camera_ray<S: Sampler>(
 
 /// Takes a band's samples; inlined into each copy of the render loop, so that it and
 /// its callees (the path loop and its next event estimation included) are compiled for
-/// each.
+/// each. Where the scene packs camera rays ([`Scene::packs_camera_rays`]) and has no
+/// media, the camera rays go eight at a time ([`render_pixels_packed`]).
 #[inline(always)]
 pub(super) fn render_pixels<S: Sampler, K: SampleSink>(
     scene: &Scene,
@@ -68,6 +69,9 @@ pub(super) fn render_pixels<S: Sampler, K: SampleSink>(
     band: Band,
     sink: &mut K,
 ) -> RenderStats {
+    if scene.media.is_none() && scene.packs_camera_rays() {
+        return render_pixels_packed(scene, sampler, band, sink);
+    }
     let Band { rows, width, pass } = band;
     let mut stats = RenderStats::default();
     // Plain nested loops: a `flat_map` over the rows kept its inner iterator's state in
@@ -84,4 +88,78 @@ pub(super) fn render_pixels<S: Sampler, K: SampleSink>(
         }
     }
     stats
+}
+
+/// [`render_pixels`] with the camera rays of eight consecutive samples of the band
+/// (in its order: the samples of a pixel, then the next pixel's, across rows) traced
+/// as one packet ([`Scene::intersect_coherent8`]); then each path goes on from its
+/// hit ([`li_from_hit`]) and its radiance goes to the sink, in the band's order. Each
+/// of the eight samples has its own sampler, positioned at its pixel sample, which
+/// draws the same dimensions in the same order as one sampler taking the samples one
+/// after the other: the image is the same, bit for bit.
+#[inline(always)]
+fn render_pixels_packed<S: Sampler, K: SampleSink>(
+    scene: &Scene,
+    sampler: &mut S,
+    band: Band,
+    sink: &mut K,
+) -> RenderStats {
+    let Band { rows, width, pass } = band;
+    let mut stats = RenderStats::default();
+    let mut packet = CameraPacket {
+        samplers: std::array::from_fn(|_| sampler.clone()),
+        film: [(UVec2::ZERO, Vec2::ZERO); PACKET],
+        rays: [Ray::new(Vec3::ZERO, Vec3::NEG_Z); PACKET],
+        len: 0,
+    };
+    for y in rows {
+        for x in 0..width {
+            let p = UVec2::new(x, y);
+            for index in pass.clone() {
+                let i = packet.len;
+                let (film_pos, ray) =
+                    camera_ray(scene, &mut packet.samplers[i], p, index, K::SPLATS);
+                packet.film[i] = (p, film_pos);
+                packet.rays[i] = ray;
+                packet.len += 1;
+                if packet.len == PACKET {
+                    packet.finish(scene, sink, &mut stats);
+                }
+            }
+        }
+    }
+    if packet.len > 0 {
+        packet.finish(scene, sink, &mut stats);
+    }
+    stats
+}
+
+/// Camera rays traced together.
+const PACKET: usize = 8;
+
+/// Up to eight pixel samples whose camera rays are made and not yet traced: each one's
+/// sampler, pixel and film position, and ray.
+struct CameraPacket<S: Sampler> {
+    samplers: [S; PACKET],
+    film: [(UVec2, Vec2); PACKET],
+    rays: [Ray; PACKET],
+    len: usize,
+}
+
+impl<S: Sampler> CameraPacket<S> {
+    /// Traces the rays, follows each path from its hit and hands the radiance to
+    /// `sink`, in the order the samples came; the packet is then empty.
+    #[inline(always)]
+    fn finish<K: SampleSink>(&mut self, scene: &Scene, sink: &mut K, stats: &mut RenderStats) {
+        let hits = scene.intersect_coherent8(&self.rays, (1u32 << self.len) - 1);
+        let samples = (self.samplers.iter_mut().zip(hits))
+            .zip(self.film.iter().zip(&self.rays))
+            .take(self.len);
+        for ((sampler, hit), (&(p, film_pos), &ray)) in samples {
+            let l = li_from_hit(scene, ray, hit, sampler, &mut stats.rays);
+            stats.paths += 1;
+            sink.add(p, film_pos, l);
+        }
+        self.len = 0;
+    }
 }

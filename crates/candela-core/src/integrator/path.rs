@@ -9,6 +9,7 @@ use super::copies::sample_direct_baseline;
 use super::copies::sample_direct_v3;
 use super::direct::{mis_weight, sample_direct, NeeVertex};
 use super::volpath;
+use crate::accel::Hit;
 use crate::bsdf::Bsdf;
 use crate::geometry::Ray;
 use crate::light::{LightId, ShadingCtx};
@@ -20,10 +21,38 @@ use crate::scene::{Scene, SurfaceInteraction};
 /// Radiance arriving along `ray`, estimated by one path; inlined into each copy of the
 /// render loop (see [`super::band::render_pixels`]).
 #[inline(always)]
-pub fn li<S: Sampler>(scene: &Scene, mut ray: Ray, sampler: &mut S, rays: &mut u64) -> Vec3 {
+pub fn li<S: Sampler>(scene: &Scene, ray: Ray, sampler: &mut S, rays: &mut u64) -> Vec3 {
     if let Some(media) = scene.media.as_deref() {
         return volpath::li(scene, media, ray, sampler, rays);
     }
+    li_surfaces::<S, false>(scene, ray, None, sampler, rays)
+}
+
+/// [`li`] of a camera ray whose closest hit `first` is already known (traced with
+/// others in a packet: [`Scene::intersect_coherent8`]), in a scene without media: the
+/// same numbers drawn in the same order, the same radiance.
+#[inline(always)]
+pub(super) fn li_from_hit<S: Sampler>(
+    scene: &Scene,
+    ray: Ray,
+    first: Option<Hit>,
+    sampler: &mut S,
+    rays: &mut u64,
+) -> Vec3 {
+    debug_assert!(scene.media.is_none());
+    li_surfaces::<S, true>(scene, ray, first, sampler, rays)
+}
+
+/// The path loop; with `KNOWN`, the camera ray's closest hit is `first` instead of a
+/// query.
+#[inline(always)]
+fn li_surfaces<S: Sampler, const KNOWN: bool>(
+    scene: &Scene,
+    mut ray: Ray,
+    first: Option<Hit>,
+    sampler: &mut S,
+    rays: &mut u64,
+) -> Vec3 {
     let mut l = Vec3::ZERO;
     let mut beta = Vec3::ONE;
     // The product of η′² over the refractions so far (see `Bsdf::eta_crossed_sq`).
@@ -50,7 +79,11 @@ pub fn li<S: Sampler>(scene: &Scene, mut ray: Ray, sampler: &mut S, rays: &mut u
             #[inline(always)]
             || BounceSamples::<S>::draw(scene, sampler),
         );
-        let hit = scene.intersect_for_shading(&ray, f32::INFINITY);
+        let hit = if KNOWN && depth == 0 {
+            scene.interaction_of(&ray, first)
+        } else {
+            scene.intersect_for_shading(&ray, f32::INFINITY)
+        };
         if hides_emitter(scene, depth, hit.as_ref()) {
             break;
         }

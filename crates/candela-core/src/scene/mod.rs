@@ -18,6 +18,7 @@ use crate::material::Material;
 use crate::math::offset_ray_origin_a;
 use crate::options::RenderOptions;
 
+mod coherent;
 mod interaction;
 mod mesh;
 
