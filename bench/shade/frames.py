@@ -84,16 +84,10 @@ def split_stage(fn, source):
     return s or "other"
 
 
-def main():
-    binary, lo, hi, paths, stage = sys.argv[1:6]
-    lines = int(sys.argv[6]) if len(sys.argv) > 6 else 30
-    (a, _), (b, where) = instruction_costs(lo), instruction_costs(hi)
-    rows = []
-    for addr, v in b.items():
-        d = (v - a.get(addr, 0)) / float(paths)
-        if abs(d) >= 1e-3 and split_stage(*where[addr]) == stage:
-            rows.append((addr, d))
-    query = "".join(f"{addr:#x}\n" for addr, _ in rows)
+def inline_frames(binary, addresses):
+    """{address: [(function, file:line) of each inlined frame, innermost first]}, from the
+    binary's debug information by `llvm-addr2line -i -f`."""
+    query = "".join(f"{addr:#x}\n" for addr in addresses)
     out = subprocess.run(["llvm-addr2line", "-i", "-f", "-C", "-a", "-e", binary],
                          input=query, capture_output=True, text=True, check=True).stdout
     frames, cur = {}, None
@@ -103,11 +97,24 @@ def main():
             cur = int(ln, 16)
             frames[cur] = []
         else:
-            frames[cur].append(next(it))  # the function line, then its file:line
+            frames[cur].append((ln, next(it)))  # the function line, then its file:line
+    return frames
+
+
+def main():
+    binary, lo, hi, paths, stage = sys.argv[1:6]
+    lines = int(sys.argv[6]) if len(sys.argv) > 6 else 30
+    (a, _), (b, where) = instruction_costs(lo), instruction_costs(hi)
+    rows = []
+    for addr, v in b.items():
+        d = (v - a.get(addr, 0)) / float(paths)
+        if abs(d) >= 1e-3 and split_stage(*where[addr]) == stage:
+            rows.append((addr, d))
+    frames = inline_frames(binary, [addr for addr, _ in rows])
     real = defaultdict(float)
     by_line = defaultdict(float)
     for addr, d in rows:
-        inner = next((loc for loc in frames.get(addr, []) if "candela-" in loc), "?")
+        inner = next((loc for _, loc in frames.get(addr, []) if "candela-" in loc), "?")
         s = stage_of(inner) or "other"
         real[s] += d
         if s == stage:

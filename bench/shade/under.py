@@ -19,7 +19,7 @@ import sys
 from collections import defaultdict
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from frames import instruction_costs  # noqa: E402
+from frames import inline_frames, instruction_costs  # noqa: E402
 from split import stage_of  # noqa: E402
 
 
@@ -31,17 +31,7 @@ def main():
     (a, _), (b, _) = instruction_costs(lo), instruction_costs(hi)
     rows = [(addr, (v - a.get(addr, 0)) / float(paths)) for addr, v in b.items()]
     rows = [(addr, d) for addr, d in rows if abs(d) >= 1e-3]
-    query = "".join(f"{addr:#x}\n" for addr, _ in rows)
-    out = subprocess.run(["llvm-addr2line", "-i", "-f", "-C", "-a", "-e", binary],
-                         input=query, capture_output=True, text=True, check=True).stdout
-    frames, cur = {}, None
-    it = iter(out.splitlines())
-    for ln in it:
-        if ln.startswith("0x"):
-            cur = int(ln, 16)
-            frames[cur] = []
-        else:
-            frames[cur].append((ln, next(it)))  # (function, file:line), innermost first
+    frames = inline_frames(binary, [addr for addr, _ in rows])
     by_stage = defaultdict(float)
     by_line = defaultdict(float)
     by_file = defaultdict(float)
