@@ -335,7 +335,7 @@ impl<S: Sampler> BounceSamples<S> {
 mod tests {
     use super::*;
 
-    /// `is_spent` is main's `beta == Vec3::ZERO || !beta.is_finite()`, channel by channel:
+    /// `is_spent` answers as `beta == Vec3::ZERO || !beta.is_finite()`, channel by channel:
     /// zeros of either sign, infinities and NaN in each position.
     #[test]
     fn a_path_is_spent_where_its_throughput_is_zero_or_not_finite() {
