@@ -91,7 +91,7 @@ impl Material {
     ///
     /// A Lambertian material of constant or checkerboard albedo, most scenes' walls, is
     /// handled here and inlined into the caller, which then need not read the BSDF back
-    /// from memory; the rest goes through [`Self::bsdf_at_general`]. (Out of line, the
+    /// from memory; the rest goes through `Self::bsdf_at_general`. (Out of line, the
     /// checkerboard walls of `bench/scenes/cornell-textured.xml` spent ~60 instructions a
     /// hit on the call's prologue and on writing the 164-byte BSDF out and reading it
     /// back.)

@@ -1,9 +1,9 @@
 //! The ray-tracing acceleration structure: a [`WideBvh`] (eight children a node) over the
-//! scene's primitives, each leaf's primitives copied into one [`block::Block`] of eight
+//! scene's primitives, each leaf's primitives copied into one `block::Block` of eight
 //! lanes with the vertices inline (no index → mesh → position chase), tested eight at a
 //! time. The build sizes leaves knowing that a leaf of up to eight triangles costs one
 //! block test ([`SahCost::BLOCKS`]). A tree of one node (a scene whose primitives fit
-//! eight blocks) is queried without the traversal ([`small`]): one leaf by its block
+//! eight blocks) is queried without the traversal (`small`): one leaf by its block
 //! test alone, several by the root's box test and their blocks near to far.
 //!
 //! Triangles keep the watertight test (Woop et al. 2013) on the same vertex values as
@@ -17,9 +17,9 @@
 //! where the CPU has them, else SSE; [`Accel::build_for`] forces one (the tests run each the CPU has
 //! against the scalar one). Every kernel finds the same hits, bit for bit.
 //!
-//! Camera rays are traced eight at a time where the tree is one node ([`coherent`]:
+//! Camera rays are traced eight at a time where the tree is one node (`coherent`:
 //! each block against the eight rays in lanes, every ray's hit that of
-//! [`Accel::intersect`] bit for bit); [`packet`] is the measured packet traversal of
+//! [`Accel::intersect`] bit for bit); `packet` is the measured packet traversal of
 //! deeper trees, which the renderer does not use.
 //!
 //! [`AccelLayout`] picks the wide nodes, full planes (the default) or quantized boxes

@@ -259,7 +259,7 @@ impl Bsdf {
     /// [`Self::sample`]: out of line, `wo` and `wi` went through memory and the caller
     /// saved its registers around the call (callgrind, Cornell: 77 instructions a call
     /// plus ~25 around it, for what is two dot products and a few compares). The other
-    /// lobes go through [`Self::f_cos_pdf_lobe`].
+    /// lobes go through `Self::f_cos_pdf_lobe`.
     #[inline(always)]
     pub fn f_cos_pdf(&self, wo: Vec3, wi: Vec3) -> (Vec3, f32) {
         let Lobe::Diffuse(d) = &self.lobe else {
@@ -289,7 +289,7 @@ impl Bsdf {
     /// inlined into the caller, so that `wo` and the frame need not be passed through
     /// memory (out of line, the loads of `wo` and of the normal, stored just before in
     /// other pieces, were this function's hottest instructions); the other lobes go
-    /// through [`Self::sample_lobe`].
+    /// through `Self::sample_lobe`.
     #[inline(always)]
     pub fn sample(&self, wo: Vec3, u_lobe: f32, u: Vec2) -> Option<BsdfSample> {
         let Lobe::Diffuse(d) = &self.lobe else {

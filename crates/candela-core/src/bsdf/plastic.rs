@@ -22,7 +22,7 @@ use crate::sampling::{cosine_hemisphere_pdf, sample_cosine_hemisphere};
 /// f_d(ωo, ωi) = T(θo) T(θi) ρ / (π η² (1 − ρ F_dr,in)).
 ///
 /// A smooth coat has T = 1 − F exactly. A rough one has the transmittance of its
-/// microfacets, shadowing included, tabulated at construction ([`CoatTransmittance`]),
+/// microfacets, shadowing included, tabulated at construction (`CoatTransmittance`),
 /// and F_dr,in integrates its internal reflectance.
 ///
 /// For the smooth coat, since ∫(1 − F(θi)) cos θi/(π η²) dωi = 1 − F_dr,in, the albedo is

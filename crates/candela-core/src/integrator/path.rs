@@ -19,7 +19,7 @@ use crate::sampler::Sampler;
 use crate::scene::{Scene, SurfaceInteraction};
 
 /// Radiance arriving along `ray`, estimated by one path; inlined into each copy of the
-/// render loop (see [`super::band::render_pixels`]).
+/// render loop (see `super::band::render_pixels`).
 #[inline(always)]
 pub fn li<S: Sampler>(scene: &Scene, ray: Ray, sampler: &mut S, rays: &mut u64) -> Vec3 {
     if let Some(media) = scene.media.as_deref() {

@@ -70,8 +70,8 @@ impl EmissionTexture {
     /// [`Texture::mean`]) so that no triangle with light in it becomes unselectable
     /// because its lookups all fell on black. Cells are weighed by the luminance of
     /// `tint` × halfway between their mean and largest lookup, mixed with a tenth of
-    /// uniform (see [`DEFENSIVE`]); where they vary little, points are drawn uniformly
-    /// (see [`MIN_SPREAD`]).
+    /// uniform (see `DEFENSIVE`); where they vary little, points are drawn uniformly
+    /// (see `MIN_SPREAD`).
     pub fn new(texture: Arc<Texture>, uv: [Vec2; 3], tint: Vec3, floor: Vec3) -> EmissionTexture {
         let uv_area = 0.5 * (uv[1] - uv[0]).perp_dot(uv[2] - uv[0]).abs();
         // Two cells a texel a side, as far as the grid goes; two lookups a cell a side,

@@ -23,9 +23,9 @@ use crate::options::LampSampling;
 ///
 /// Sampled uniformly by area; the density in solid angle at the shading point is
 /// p_ω = d² / (|cos θ_l| · A), as for [`TriangleLight`]. With
-/// [`LampSampling::SolidAngle`], a rectangle that is near (see [`spherical::near`]) has
+/// [`LampSampling::SolidAngle`], a rectangle that is near (see `spherical::near`) has
 /// its direction drawn in the spherical rectangle it covers instead, weighted by the
-/// receiver's cosine ([`SphericalRectangle`]); a parallelogram with skewed corners stays
+/// receiver's cosine (`SphericalRectangle`); a parallelogram with skewed corners stays
 /// sampled by area.
 #[derive(Clone, Debug)]
 pub struct ParallelogramLight {

@@ -165,7 +165,7 @@ impl SpotLight {
 
     /// An emission direction and its solid-angle density. Without a profile: uniform in
     /// the inner cone or uniform in the falloff band (in cos θ and φ), picked by
-    /// [`Self::inner_probability`]; with one, the profile's table sampling.
+    /// `Self::inner_probability`; with one, the profile's table sampling.
     pub fn sample_emission(&self, u: Vec2) -> Option<(Vec3, f32)> {
         if let Some(p) = &self.profile {
             let (w, pdf) = p.sample(u);

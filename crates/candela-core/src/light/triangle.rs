@@ -16,8 +16,8 @@ use crate::sampling::sample_uniform_triangle;
 /// One emitting triangle of a mesh. Emits `le` on the side its normal `n` points to.
 /// Sampled uniformly by area; the density is converted to solid angle at the shading
 /// point, p_ω = d² / (|cos θ_l| · A). With [`LampSampling::SolidAngle`], where it is near
-/// (see [`spherical::near`]), the direction is drawn in the spherical triangle it covers
-/// instead, weighted by the receiver's cosine ([`SphericalTriangle`]).
+/// (see `spherical::near`), the direction is drawn in the spherical triangle it covers
+/// instead, weighted by the receiver's cosine (`SphericalTriangle`).
 ///
 /// With a `profile` (an IES-shaped area light) the radiance leaving towards ω is
 /// `le` · I(ω)/I_max, the profile's nadir along `n`: each point of the surface emits with

@@ -198,7 +198,7 @@ impl LightBvh {
     /// A flat tree without infinite lights, most scenes' few lamps, is sampled here, inlined
     /// into the caller (the render loop's AVX2 copy, which then inlines the lanes'
     /// evaluation too); the rest out of line. There the tree is picked with probability 1
-    /// and `u` passes unchanged: the same numbers as [`Self::sample_general`]'s
+    /// and `u` passes unchanged: the same numbers as `Self::sample_general`'s
     /// `(u − 0) / 1` and `1 · p`.
     #[inline]
     pub fn sample(&self, ctx: &ShadingCtx, u: f32) -> Option<(u32, f32)> {

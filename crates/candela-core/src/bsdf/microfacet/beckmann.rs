@@ -87,7 +87,7 @@ impl MicrofacetDistribution for Beckmann {
     }
 
     /// Jakob 2014: stretch `w` to the α = 1 configuration, draw a slope of the visible
-    /// normals there ([`sample_unit_slope`]), rotate it to `w`'s azimuth and unstretch.
+    /// normals there (`sample_unit_slope`), rotate it to `w`'s azimuth and unstretch.
     fn sample_wm(&self, w: Vec3, u: Vec2) -> Vec3 {
         let w = if w.z < 0.0 { -w } else { w };
         let ws = Vec3::new(self.alpha_x * w.x, self.alpha_y * w.y, w.z).normalize();

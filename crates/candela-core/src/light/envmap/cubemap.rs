@@ -21,7 +21,7 @@
 //! Sampling works on the faces directly: face `f` is chosen in proportion to its share
 //! of the importance, then a point of it by a bilinear density through its texel centres
 //! and edges ([`Bilinear2D`]), weighted by the luminance above half the map's mean
-//! ([`compensated`]) times the solid angle, dω = 4 (1 + a² + b²)^(−3/2) ds dt with
+//! (`compensated`) times the solid angle, dω = 4 (1 + a² + b²)^(−3/2) ds dt with
 //! a = 2s − 1, b = 2t − 1.
 
 use glam::{Vec2, Vec3};

@@ -19,7 +19,7 @@ use crate::sampling::sin_cos_quarter_turns;
 /// blend of a weight × sin θ at the vertices (zero at the poles), sampled exactly
 /// ([`Bilinear2D`]): as Mitsuba 3's `envmap`, so the density follows the radiance within
 /// every texel, a sun's rim included, not a step function over it. The weight is the
-/// luminance above half the map's mean (with a floor: see [`compensated`]).
+/// luminance above half the map's mean (with a floor: see `compensated`).
 #[derive(Clone, Debug)]
 pub struct Equirect {
     pub image: Image,
@@ -31,7 +31,7 @@ pub struct Equirect {
     half_texel: f32,
 }
 
-/// Image coordinates (u right, v down, both in [0,1]) of a unit direction.
+/// Image coordinates (u right, v down, both in \[0, 1\]) of a unit direction.
 pub fn direction_to_uv(d: Vec3) -> Vec2 {
     direction_to_uv_sin(d).0
 }

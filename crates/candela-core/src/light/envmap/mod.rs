@@ -12,7 +12,7 @@
 //! Both sample a bilinear density through the texel centres (and the edges, where the
 //! lookup clamps), so that the density follows the filtered radiance within every texel
 //! ([`bilinear`], as Mitsuba 3's `envmap`); its weights are the luminance above half the
-//! map's mean, floored ([`compensated`]), times the mapping's Jacobian. The density is positive
+//! map's mean, floored (`compensated`), times the mapping's Jacobian. The density is positive
 //! wherever the filtered radiance is.
 
 pub mod bilinear;
