@@ -553,11 +553,6 @@ unsafe fn intersect_tree<
     filter: &impl Fn(u32, &TriangleHit) -> bool,
 ) -> Option<Hit> {
     let r8 = Ray8::new(ray);
-    // Made in the set-up, not at the first leaf as `occluded_tree`'s: a closest-hit query
-    // tests a block far more often than a shadow ray, and made lazily they cost a closed
-    // room more than they saved the open scenes (callgrind, instructions a closest-hit
-    // query, 48² 4 spp, the box 2 spp: `scenes/cornell.toml` 527.9 -> 551.4, many-lights
-    // 421.8 -> 415.7, glossy-plates 425.5 -> 416.2).
     let wray = WatertightRay::from_recip(ray, r8.inv_d);
     let mut best: Option<Hit> = None;
     tree.intersect::<K>(
@@ -616,13 +611,14 @@ unsafe fn occluded_tree<
     filter: &impl Fn(u32, &TriangleHit) -> bool,
 ) -> bool {
     let r8 = Ray8::new(ray);
-    let mut wray = None;
+    let wray = WatertightRay::from_recip(ray, r8.inv_d);
     tree.occluded::<K>(
         &r8,
         t_max,
         #[inline(always)]
         |leaf, count, t_max| {
-            let (ray, wray) = leaf_ray(ray, &r8, &mut wray);
+            // As in `intersect_tree`: the broadcasts where a block is tested.
+            let wray = std::hint::black_box(&wray);
             leaves.with_block(
                 leaf,
                 count,
@@ -637,32 +633,6 @@ unsafe fn occluded_tree<
             )
         },
     )
-}
-
-/// The ray and its watertight constants as a shadow ray's block test takes them. The
-/// constants are made at the query's first leaf rather than in its set-up: many shadow
-/// rays through trees of several nodes test no block at all (callgrind,
-/// `bench/scenes/many-lights.xml` 48², 4 spp: 0.09 blocks a shadow ray), and the same
-/// division's bits make them the same whenever they are made. Both come back opaque to
-/// the optimizer, so that the block test's broadcasts of them (the watertight ray's, and
-/// the sphere test's of the direction) are made where a block is tested: otherwise they
-/// are hoisted into the set-up and spilled, paid by every query (callgrind, Cornell render
-/// 128², 1 spp, the watertight ray's: shadow 366.1 -> 347.1 instructions a query).
-/// Instructions a shadow ray, main -> this (48², 4 spp; the box 2 spp): many-lights 321.1
-/// -> 298.5, `scenes/cornell.toml` 335.4 -> 331.8, glossy-plates (spheres) 400.2 ->
-/// 406.6 (nearly all of its shadow rays test a block of spheres; with the direction's
-/// broadcasts hoisted, 416.1). A hint: it changes no result.
-#[inline(always)]
-fn leaf_ray<'a>(
-    ray: &'a Ray,
-    r8: &Ray8,
-    wray: &'a mut Option<WatertightRay>,
-) -> (&'a Ray, &'a WatertightRay) {
-    let w = wray.get_or_insert_with(
-        #[inline(always)]
-        || WatertightRay::from_recip(ray, r8.inv_d),
-    );
-    std::hint::black_box((ray, &*w))
 }
 
 /// Where the traversal finds a leaf's block: the inline blocks hold it, an indexed leaf
