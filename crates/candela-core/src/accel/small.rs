@@ -18,7 +18,7 @@ use crate::bvh::SseBoxes;
 use crate::bvh::{BoxTest, Node8, Ray8, ScalarBoxes, Simd, WideBvh, T_MAX_SCALE};
 use crate::geometry::{Ray, TriangleHit, WatertightRay};
 
-use super::block::{self, LaneHit};
+use super::block::{self, Block, LaneHit};
 use super::{Accel, LeafBlocks, Leaves, NodeLayout};
 
 /// A tree of one node, as its queries want it: at most one of the two is set. Two
@@ -31,7 +31,89 @@ pub(super) struct SmallTree {
     pub(super) leaf: Option<SoleLeaf>,
     /// A root whose two to eight children are all leaves (a tree of one node has no
     /// interior child). Boxed: the structure stays small for trees that are not one node.
-    pub(super) root: Option<Box<Node8>>,
+    pub(super) root: Option<Box<SmallRoot>>,
+}
+
+/// The root of a tree of one node over several leaves, with the boxes of its blocks'
+/// spheres in the lanes its leaves leave free: the root's box test then tells, for
+/// nothing more, which spheres the ray cannot meet, and their lanes skip the vector
+/// sphere test (about 50 instructions a block, paid on the rooms by nearly every query,
+/// whose sphere shares a block with walls).
+#[derive(Clone, Debug)]
+pub(super) struct SmallRoot {
+    /// The root node; a sphere's lane has its box and no primitives (count 0).
+    pub(super) node: Node8,
+    /// The lanes that are leaves (bit i for lane i).
+    pub(super) leaves: u32,
+    /// By leaf lane: the lanes that hold its spheres' boxes, in the order of…
+    sphere_boxes: [u8; 8],
+    /// …its spheres' lanes in its block.
+    spheres: [u8; 8],
+}
+
+impl SmallRoot {
+    /// `node` with the boxes of the spheres of `blocks` (its leaves' blocks, where the
+    /// leaves are inline) in its free lanes, as many as fit.
+    ///
+    /// A sphere's box is widened by 1/256 of the radius plus the largest coordinate of
+    /// the root's box: the sphere test's distance is rounded (its discriminant to a few
+    /// ulps of the ray origin's distance from the centre), so a ray it reports hit may
+    /// pass just outside the sphere, and the margin keeps every such ray inside the box
+    /// (for origins within 2^16 scene sizes of it), so that culling changes no hit.
+    fn new(node: Node8, blocks: Option<&[Block]>) -> SmallRoot {
+        let leaves = (0..8).filter(|&l| node.count[l] > 0).fold(0, |m, l| m | 1 << l);
+        let mut root = SmallRoot {
+            node,
+            leaves,
+            sphere_boxes: [0; 8],
+            spheres: [0; 8],
+        };
+        let Some(blocks) = blocks else {
+            return root;
+        };
+        let scale = (0..8)
+            .filter(|&l| leaves & 1 << l != 0)
+            .flat_map(|l| node.planes.iter().map(move |row| row[l].abs()))
+            .fold(0.0f32, f32::max);
+        let mut free = !leaves & 0xff;
+        for lane in 0..8 {
+            if leaves & 1 << lane == 0 {
+                continue;
+            }
+            let block = &blocks[node.child[lane] as usize];
+            for (sphere, centre, radius) in block.spheres(node.count[lane] as u32) {
+                if free == 0 {
+                    return root;
+                }
+                let at = free.trailing_zeros() as usize;
+                free &= free - 1;
+                let extent = radius + (radius + scale) / 256.0;
+                for axis in 0..3 {
+                    root.node.planes[2 * axis][at] = centre[axis] - extent;
+                    root.node.planes[2 * axis + 1][at] = centre[axis] + extent;
+                }
+                root.sphere_boxes[lane] |= 1 << at;
+                root.spheres[lane] |= 1 << sphere;
+            }
+        }
+        root
+    }
+
+    /// The sphere lanes of leaf `lane`'s block whose boxes the box test `hits` missed.
+    #[inline(always)]
+    fn missed_spheres(&self, lane: usize, hits: u32) -> u32 {
+        let (mut boxes, mut spheres) = (self.sphere_boxes[lane] as u32, self.spheres[lane] as u32);
+        let mut missed = 0;
+        while spheres != 0 {
+            let sphere = spheres & spheres.wrapping_neg();
+            if hits & boxes & boxes.wrapping_neg() == 0 {
+                missed |= sphere;
+            }
+            spheres ^= sphere;
+            boxes &= boxes - 1;
+        }
+        missed
+    }
 }
 
 /// A leaf as a wide node's lane names it (its block, or its first record), and its
@@ -47,7 +129,13 @@ impl SmallTree {
     /// names them) can shortcut, if anything. One node over several leaves only with
     /// full-precision boxes: the quantized layout keeps the traversal, whose hits on
     /// its wider boxes it would not reproduce bit for bit otherwise.
-    pub(super) fn of(bvh: &WideBvh<Node8>, nodes: NodeLayout) -> SmallTree {
+    /// `blocks`: the leaves' blocks where they are inline (the root's sphere boxes,
+    /// [`SmallRoot`]).
+    pub(super) fn of(
+        bvh: &WideBvh<Node8>,
+        nodes: NodeLayout,
+        blocks: Option<&[Block]>,
+    ) -> SmallTree {
         if let Some((leaf, count)) = bvh.sole_leaf() {
             return SmallTree {
                 leaf: Some(SoleLeaf { leaf, count }),
@@ -57,7 +145,7 @@ impl SmallTree {
         SmallTree {
             leaf: None,
             root: match (bvh.sole_node(), nodes) {
-                (Some(root), NodeLayout::Full) => Some(Box::new(*root)),
+                (Some(root), NodeLayout::Full) => Some(Box::new(SmallRoot::new(*root, blocks))),
                 _ => None,
             },
         }
@@ -196,7 +284,7 @@ impl SmallQuery for SoleLeaf {
     }
 }
 
-impl SmallQuery for Node8 {
+impl SmallQuery for SmallRoot {
     #[inline(always)]
     unsafe fn query<K: BoxTest, const LEAF: u8, const ANY: bool, const PLAIN: bool, L>(
         &self,
@@ -217,14 +305,14 @@ impl SmallQuery for Node8 {
 /// entries), and stops at the first entered beyond the nearest hit so far (widened by
 /// [`T_MAX_SCALE`]): the order and the cut of [`WideBvh::intersect`], whose pops skip
 /// every farther one too. An any-hit query tests them in lane order, as
-/// [`WideBvh::occluded`] does.
+/// [`WideBvh::occluded`] does. The spheres whose boxes the ray misses are not tested.
 ///
 /// # Safety
 /// The CPU must support `K` and `LEAF`.
 #[inline(always)]
 unsafe fn root_query<K: BoxTest, const LEAF: u8, const ANY: bool, const PLAIN: bool, L>(
     leaves: &L,
-    root: &Node8,
+    root: &SmallRoot,
     ray: &Ray,
     t_max: f32,
     filter: &impl Fn(u32, &TriangleHit) -> bool,
@@ -239,7 +327,8 @@ where
     let wray = WatertightRay::from_recip(ray, r8.inv_d);
     let r = K::prepare(&r8);
     let mut t_box = t_max * T_MAX_SCALE;
-    let (mut mask, t_near) = K::hit8(&r, &root.planes, t_box);
+    let (hits, t_near) = K::hit8(&r, &root.node.planes, t_box);
+    let mut mask = hits & root.leaves;
     let mut t_max = t_max;
     let mut best = None;
     while mask != 0 {
@@ -253,15 +342,18 @@ where
             lane
         };
         mask &= !(1 << lane);
-        let count = root.count[lane] as u32;
+        let count = root.node.count[lane] as u32;
+        let culled = if PLAIN { 0 } else { root.missed_spheres(lane, hits) };
         // Opaque, as in the traversal: the block test's broadcasts are made where a
         // block is tested, not hoisted into the set-up and spilled.
         let (ray, wray) = std::hint::black_box((ray, &wray));
         let hit = leaves.with_block(
-            root.child[lane],
+            root.node.child[lane],
             count,
             #[inline(always)]
-            |block| block.intersect::<LEAF, ANY, PLAIN>(ray, wray, count, t_max, filter),
+            |block| {
+                block.intersect_culled::<LEAF, ANY, PLAIN>(ray, wray, count, t_max, culled, filter)
+            },
         );
         if let Some(h) = hit {
             if ANY {
