@@ -117,7 +117,9 @@ mod x86 {
                     .intersect_rays8::<PLAIN>(&packet, active, sole.count, &mut best, filter);
             }
         } else if let Some(root) = &small.root {
-            root8::<PLAIN>(blocks, &root.node, &packet, &mut boxes, active, &mut best, filter);
+            root8::<PLAIN>(
+                blocks, &root.node, &packet, &mut boxes, active, &mut best, filter,
+            );
         }
         std::array::from_fn(|i| {
             (best.found & (1 << i) != 0).then(|| Hit {
