@@ -103,6 +103,13 @@ impl Block {
         Vec3::new(v[0][lane], v[1][lane], v[2][lane])
     }
 
+    /// The sphere lanes among the first `count`: lane, centre and radius.
+    pub fn spheres(&self, count: u32) -> impl Iterator<Item = (usize, Vec3, f32)> + '_ {
+        (0..count as usize)
+            .filter(|&lane| self.id[lane] & SPHERE != 0)
+            .map(|lane| (lane, self.vertex(0, lane), self.v[1][0][lane]))
+    }
+
     /// Whether every lane is an unfiltered triangle.
     pub fn is_plain(&self) -> bool {
         self.id.iter().all(|&id| id & (SPHERE | FILTERED) == 0)
@@ -156,6 +163,24 @@ impl Block {
         t_max: f32,
         filter: &impl Fn(u32, &TriangleHit) -> bool,
     ) -> Option<LaneHit> {
+        self.intersect_culled::<KERNEL, ANY, PLAIN>(ray, wray, count, t_max, 0, filter)
+    }
+
+    /// [`Block::intersect`] without testing the sphere lanes `culled` (bit i for lane
+    /// i): spheres the caller knows the ray misses within `t_max` (the one-node query's
+    /// box test of their boxes, `super::small`). A sphere lane costs the vector sphere
+    /// test whether one or eight are tested; where every sphere lane of a register is
+    /// culled, the test is skipped.
+    #[inline(always)]
+    pub fn intersect_culled<const KERNEL: u8, const ANY: bool, const PLAIN: bool>(
+        &self,
+        ray: &Ray,
+        wray: &WatertightRay,
+        count: u32,
+        t_max: f32,
+        culled: u32,
+        filter: &impl Fn(u32, &TriangleHit) -> bool,
+    ) -> Option<LaneHit> {
         #[cfg(target_arch = "x86_64")]
         if KERNEL != SCALAR {
             // A filtered lane takes the scalar test within the vector one, so a mixed
@@ -170,12 +195,19 @@ impl Block {
             return unsafe {
                 if PLAIN {
                     self.intersect_lanes::<KERNEL, ANY, false>(
-                        ray, wray, count, t_max, 0, 0, filter,
+                        ray, wray, count, t_max, 0, 0, 0, filter,
                     )
                 } else {
                     let (spheres, filtered) = self.flag_lanes::<KERNEL>(count);
                     self.intersect_lanes::<KERNEL, ANY, true>(
-                        ray, wray, count, t_max, spheres, filtered, filter,
+                        ray,
+                        wray,
+                        count,
+                        t_max,
+                        spheres,
+                        spheres & !culled,
+                        filtered,
+                        filter,
                     )
                 }
             };
@@ -183,6 +215,9 @@ impl Block {
         let mut best = None;
         let mut t_max = t_max;
         for lane in 0..count as usize {
+            if culled & (1 << lane) != 0 {
+                continue;
+            }
             if let Some(hit) = self.lane_test(ray, wray, lane, t_max, filter) {
                 t_max = hit.t;
                 best = Some(LaneHit {
@@ -225,9 +260,9 @@ impl Block {
     }
 
     /// The vector test of a block: the nearest hit, the lowest lane among equals (as a
-    /// sequential loop that narrows `t_max` would find). The `spheres` lanes take the
-    /// vector sphere test; the `special` lanes (filtered triangles) take
-    /// [`Block::lane_test`] in that loop instead.
+    /// sequential loop that narrows `t_max` would find). The `spheres` lanes are not
+    /// triangles, and those of them in `live` take the vector sphere test; the `special`
+    /// lanes (filtered triangles) take [`Block::lane_test`] in that loop instead.
     ///
     /// # Safety
     /// The CPU must support `KERNEL`.
@@ -241,6 +276,7 @@ impl Block {
         count: u32,
         t_max: f32,
         spheres: u32,
+        live: u32,
         special: u32,
         filter: &impl Fn(u32, &TriangleHit) -> bool,
     ) -> Option<LaneHit> {
@@ -250,10 +286,18 @@ impl Block {
         let mut out = MaybeUninit::<Lanes>::uninit();
         let out = out.as_mut_ptr();
         let (hit, edge) = if KERNEL == AVX2 {
-            self.test_lanes::<__m256, ANY, MIXED>(ray, w, 0, used, spheres, t_max, out)
+            self.test_lanes::<__m256, ANY, MIXED>(ray, w, 0, used, spheres, live, t_max, out)
         } else {
-            let (h0, e0) =
-                self.test_lanes::<__m128, ANY, MIXED>(ray, w, 0, used & 15, spheres, t_max, out);
+            let (h0, e0) = self.test_lanes::<__m128, ANY, MIXED>(
+                ray,
+                w,
+                0,
+                used & 15,
+                spheres,
+                live,
+                t_max,
+                out,
+            );
             // (A special lane's bit says nothing: only a triangle's hit ends a shadow ray.)
             if count <= 4 || (ANY && h0 & !special != 0) {
                 (h0, e0)
@@ -264,6 +308,7 @@ impl Block {
                     4,
                     used >> 4,
                     spheres,
+                    live,
                     t_max,
                     out,
                 );
@@ -336,8 +381,9 @@ impl Block {
     }
 
     /// [`WatertightRay::intersect`] on the `V::LANES` lanes from `first` on (`used`: the
-    /// filled ones, bit 0 = lane `first`), and [`intersect_sphere`] on those of them that
-    /// `spheres` names (bits of the block's lanes): which are hit without an
+    /// filled ones, bit 0 = lane `first`) that `spheres` does not name (bits of the
+    /// block's lanes), and [`intersect_sphere`] on those that `live` (a part of
+    /// `spheres`) names: which are hit without an
     /// exactly-zero edge function, and which triangles have one (for the scalar retry),
     /// as bits of the block's lanes. Where some lane is either, the distances (and
     /// without `ANY` the barycentrics, zero for a sphere) go to `out`.
@@ -354,6 +400,7 @@ impl Block {
         first: usize,
         used: u32,
         spheres: u32,
+        live: u32,
         t_max: f32,
         out: *mut Lanes,
     ) -> (u32, u32) {
@@ -363,16 +410,17 @@ impl Block {
         // The sphere lanes of this register, tested together; a block of triangles only
         // pays this branch.
         let sph = if MIXED { (spheres >> first) & used } else { 0 };
-        let (sphere_hit, sphere_t) = if sph != 0 {
+        let live = if MIXED { (live >> first) & used } else { 0 };
+        let (sphere_hit, sphere_t) = if live != 0 {
             let at = |vertex: usize, axis: usize| self.v[vertex][axis].as_ptr().add(first);
             let (hit, t) = sphere::intersect_spheres::<V>(
                 ray,
                 [0, 1, 2].map(|k| at(0, k)),
                 at(1, 0),
                 t_max,
-                sph,
+                live,
             );
-            (hit.and(V::from_bits(sph)), t)
+            (hit.and(V::from_bits(live)), t)
         } else {
             (zero, zero)
         };

@@ -103,7 +103,10 @@ mod x86 {
                 // The root's box test, as `root_query` makes it.
                 let prepared = Avx2Boxes::prepare(&Ray8::new(&rays[i]));
                 let t_box = t_max[i] * T_MAX_SCALE;
-                (boxes.mask[i], boxes.t_near[i]) = Avx2Boxes::hit8(&prepared, &root.planes, t_box);
+                let (hits, t_near) = Avx2Boxes::hit8(&prepared, &root.node.planes, t_box);
+                // The leaves' lanes (the others hold spheres' boxes, which the packet's
+                // block tests do not use).
+                (boxes.mask[i], boxes.t_near[i]) = (hits & root.leaves, t_near);
             }
         }
         let active = live;
@@ -114,7 +117,9 @@ mod x86 {
                     .intersect_rays8::<PLAIN>(&packet, active, sole.count, &mut best, filter);
             }
         } else if let Some(root) = &small.root {
-            root8::<PLAIN>(blocks, root, &packet, &mut boxes, active, &mut best, filter);
+            root8::<PLAIN>(
+                blocks, &root.node, &packet, &mut boxes, active, &mut best, filter,
+            );
         }
         std::array::from_fn(|i| {
             (best.found & (1 << i) != 0).then(|| Hit {

@@ -45,7 +45,7 @@ use crate::bvh::{BoxTest, Bvh, Node8, QNode8, Ray8, SahCost, ScalarBoxes, WideBv
 use crate::geometry::{Aabb, Ray, TriangleHit, WatertightRay};
 use block::{Block, FILTERED, ID_MASK, LANES, SPHERE};
 use indexed::IndexedLeaves;
-use small::{SmallTree, SoleLeaf};
+use small::{SmallRoot, SmallTree, SoleLeaf};
 
 pub use crate::bvh::Simd;
 pub use geometry::{Geometry, Located, TriangleMesh};
@@ -214,7 +214,11 @@ impl Accel {
             Leaves::Inline(blocks) => blocks.iter().all(Block::is_plain),
             Leaves::Indexed(x) => x.is_plain(),
         };
-        let small = SmallTree::of(&bvh, layout.nodes);
+        let blocks = match &leaves {
+            Leaves::Inline(blocks) => Some(&blocks[..]),
+            Leaves::Indexed(_) => None,
+        };
+        let small = SmallTree::of(&bvh, layout.nodes, blocks);
         let tree = match layout.nodes {
             NodeLayout::Full => Tree::Full(bvh),
             NodeLayout::Quantized => Tree::Quantized(bvh.quantize()),
@@ -297,7 +301,7 @@ impl Accel {
         }
         if let Some(root) = &self.small.root {
             return self
-                .small_hit::<Node8, false, _>(root, ray, t_max, &filter)
+                .small_hit::<SmallRoot, false, _>(root, ray, t_max, &filter)
                 .map(hit);
         }
         // The leaf layout first, so that each kernel's traversal is compiled once per
@@ -338,7 +342,7 @@ impl Accel {
         }
         if let Some(root) = &self.small.root {
             return self
-                .small_hit::<Node8, true, _>(root, ray, t_max, &filter)
+                .small_hit::<SmallRoot, true, _>(root, ray, t_max, &filter)
                 .is_some();
         }
         match &self.leaves {

@@ -3,7 +3,9 @@
 //! child ranks): one leaf is tested straight away, and one node over several leaves
 //! takes its box test, then its blocks near to far, each only while it is entered before
 //! the nearest hit so far. Each finds the traversal's hits, bit for bit: the same block
-//! tests with the same `t_max`, in the traversal's order.
+//! tests with the same `t_max`, in the traversal's order. The root's unused lanes hold
+//! its blocks' spheres' boxes, so that its box test also tells which spheres a ray
+//! cannot meet ([`SmallRoot`]); under AVX2 the set-up is made in registers (`setup`).
 //!
 //! Apart from the traversal, so that its code is as it was for other trees (a check
 //! inside it cost the spot room 1–5 instructions a query, and an arm beside it changed
@@ -11,14 +13,16 @@
 //! and one call: the AVX2 query compiled for AVX2, the others out of line (an
 //! out-of-line dispatch cost 42 instructions a query).
 
+mod setup;
+
 #[cfg(target_arch = "x86_64")]
 use crate::bvh::Avx2Boxes;
 #[cfg(target_arch = "x86_64")]
 use crate::bvh::SseBoxes;
-use crate::bvh::{BoxTest, Node8, Ray8, ScalarBoxes, Simd, WideBvh, T_MAX_SCALE};
+use crate::bvh::{BoxTest, Node8, Planes8, Ray8, ScalarBoxes, Simd, WideBvh, T_MAX_SCALE};
 use crate::geometry::{Ray, TriangleHit, WatertightRay};
 
-use super::block::{self, LaneHit};
+use super::block::{self, Block, LaneHit};
 use super::{Accel, LeafBlocks, Leaves, NodeLayout};
 
 /// A tree of one node, as its queries want it: at most one of the two is set. Two
@@ -31,7 +35,91 @@ pub(super) struct SmallTree {
     pub(super) leaf: Option<SoleLeaf>,
     /// A root whose two to eight children are all leaves (a tree of one node has no
     /// interior child). Boxed: the structure stays small for trees that are not one node.
-    pub(super) root: Option<Box<Node8>>,
+    pub(super) root: Option<Box<SmallRoot>>,
+}
+
+/// The root of a tree of one node over several leaves, with the boxes of its blocks'
+/// spheres in the lanes its leaves leave free: the root's box test then tells, for
+/// nothing more, which spheres the ray cannot meet, and their lanes skip the vector
+/// sphere test (about 50 instructions a block, paid on the rooms by nearly every query,
+/// whose sphere shares a block with walls).
+#[derive(Clone, Debug)]
+pub(super) struct SmallRoot {
+    /// The root node; a sphere's lane has its box and no primitives (count 0).
+    pub(super) node: Node8,
+    /// The lanes that are leaves (bit i for lane i).
+    pub(super) leaves: u32,
+    /// By leaf lane: the lanes that hold its spheres' boxes, in the order of…
+    sphere_boxes: [u8; 8],
+    /// …its spheres' lanes in its block.
+    spheres: [u8; 8],
+}
+
+impl SmallRoot {
+    /// `node` with the boxes of the spheres of `blocks` (its leaves' blocks, where the
+    /// leaves are inline) in its free lanes, as many as fit.
+    ///
+    /// A sphere's box is widened by 1/256 of the radius plus the largest coordinate of
+    /// the root's box: the sphere test's distance is rounded (its discriminant to a few
+    /// ulps of the ray origin's distance from the centre), so a ray it reports hit may
+    /// pass just outside the sphere, and the margin keeps every such ray inside the box
+    /// (for origins within 2^16 scene sizes of it), so that culling changes no hit.
+    fn new(node: Node8, blocks: Option<&[Block]>) -> SmallRoot {
+        let leaves = (0..8)
+            .filter(|&l| node.count[l] > 0)
+            .fold(0, |m, l| m | 1 << l);
+        let mut root = SmallRoot {
+            node,
+            leaves,
+            sphere_boxes: [0; 8],
+            spheres: [0; 8],
+        };
+        let Some(blocks) = blocks else {
+            return root;
+        };
+        let scale = (0..8)
+            .filter(|&l| leaves & 1 << l != 0)
+            .flat_map(|l| node.planes.iter().map(move |row| row[l].abs()))
+            .fold(0.0f32, f32::max);
+        let mut free = !leaves & 0xff;
+        for lane in 0..8 {
+            if leaves & 1 << lane == 0 {
+                continue;
+            }
+            let block = &blocks[node.child[lane] as usize];
+            for (sphere, centre, radius) in block.spheres(node.count[lane] as u32) {
+                if free == 0 {
+                    return root;
+                }
+                let at = free.trailing_zeros() as usize;
+                free &= free - 1;
+                let extent = radius + (radius + scale) / 256.0;
+                for axis in 0..3 {
+                    root.node.planes[2 * axis][at] = centre[axis] - extent;
+                    root.node.planes[2 * axis + 1][at] = centre[axis] + extent;
+                }
+                root.sphere_boxes[lane] |= 1 << at;
+                root.spheres[lane] |= 1 << sphere;
+            }
+        }
+        root
+    }
+
+    /// The sphere lanes of leaf `lane`'s block whose boxes the box test `hits` missed.
+    #[inline(always)]
+    fn missed_spheres(&self, lane: usize, hits: u32) -> u32 {
+        let (mut boxes, mut spheres) = (self.sphere_boxes[lane] as u32, self.spheres[lane] as u32);
+        let mut missed = 0;
+        while spheres != 0 {
+            let sphere = spheres & spheres.wrapping_neg();
+            if hits & boxes & boxes.wrapping_neg() == 0 {
+                missed |= sphere;
+            }
+            spheres ^= sphere;
+            boxes &= boxes - 1;
+        }
+        missed
+    }
 }
 
 /// A leaf as a wide node's lane names it (its block, or its first record), and its
@@ -47,7 +135,13 @@ impl SmallTree {
     /// names them) can shortcut, if anything. One node over several leaves only with
     /// full-precision boxes: the quantized layout keeps the traversal, whose hits on
     /// its wider boxes it would not reproduce bit for bit otherwise.
-    pub(super) fn of(bvh: &WideBvh<Node8>, nodes: NodeLayout) -> SmallTree {
+    /// `blocks`: the leaves' blocks where they are inline (the root's sphere boxes,
+    /// [`SmallRoot`]).
+    pub(super) fn of(
+        bvh: &WideBvh<Node8>,
+        nodes: NodeLayout,
+        blocks: Option<&[Block]>,
+    ) -> SmallTree {
         if let Some((leaf, count)) = bvh.sole_leaf() {
             return SmallTree {
                 leaf: Some(SoleLeaf { leaf, count }),
@@ -57,7 +151,7 @@ impl SmallTree {
         SmallTree {
             leaf: None,
             root: match (bvh.sole_node(), nodes) {
-                (Some(root), NodeLayout::Full) => Some(Box::new(*root)),
+                (Some(root), NodeLayout::Full) => Some(Box::new(SmallRoot::new(*root, blocks))),
                 _ => None,
             },
         }
@@ -196,7 +290,7 @@ impl SmallQuery for SoleLeaf {
     }
 }
 
-impl SmallQuery for Node8 {
+impl SmallQuery for SmallRoot {
     #[inline(always)]
     unsafe fn query<K: BoxTest, const LEAF: u8, const ANY: bool, const PLAIN: bool, L>(
         &self,
@@ -217,14 +311,14 @@ impl SmallQuery for Node8 {
 /// entries), and stops at the first entered beyond the nearest hit so far (widened by
 /// [`T_MAX_SCALE`]): the order and the cut of [`WideBvh::intersect`], whose pops skip
 /// every farther one too. An any-hit query tests them in lane order, as
-/// [`WideBvh::occluded`] does.
+/// [`WideBvh::occluded`] does. The spheres whose boxes the ray misses are not tested.
 ///
 /// # Safety
 /// The CPU must support `K` and `LEAF`.
 #[inline(always)]
 unsafe fn root_query<K: BoxTest, const LEAF: u8, const ANY: bool, const PLAIN: bool, L>(
     leaves: &L,
-    root: &Node8,
+    root: &SmallRoot,
     ray: &Ray,
     t_max: f32,
     filter: &impl Fn(u32, &TriangleHit) -> bool,
@@ -232,14 +326,17 @@ unsafe fn root_query<K: BoxTest, const LEAF: u8, const ANY: bool, const PLAIN: b
 where
     L: LeafBlocks + ?Sized,
 {
-    let r8 = Ray8::new(ray);
-    if !r8.finite {
-        return None;
-    }
-    let wray = WatertightRay::from_recip(ray, r8.inv_d);
-    let r = K::prepare(&r8);
     let mut t_box = t_max * T_MAX_SCALE;
-    let (mut mask, t_near) = K::hit8(&r, &root.planes, t_box);
+    #[cfg(target_arch = "x86_64")]
+    let set_up = if LEAF == block::AVX2 {
+        setup::root_setup(ray, &root.node.planes, t_box)
+    } else {
+        root_setup::<K>(ray, &root.node.planes, t_box)
+    };
+    #[cfg(not(target_arch = "x86_64"))]
+    let set_up = root_setup::<K>(ray, &root.node.planes, t_box);
+    let (hits, t_near, wray) = set_up?;
+    let mut mask = hits & root.leaves;
     let mut t_max = t_max;
     let mut best = None;
     while mask != 0 {
@@ -253,15 +350,22 @@ where
             lane
         };
         mask &= !(1 << lane);
-        let count = root.count[lane] as u32;
+        let count = root.node.count[lane] as u32;
+        let culled = if PLAIN {
+            0
+        } else {
+            root.missed_spheres(lane, hits)
+        };
         // Opaque, as in the traversal: the block test's broadcasts are made where a
         // block is tested, not hoisted into the set-up and spilled.
         let (ray, wray) = std::hint::black_box((ray, &wray));
         let hit = leaves.with_block(
-            root.child[lane],
+            root.node.child[lane],
             count,
             #[inline(always)]
-            |block| block.intersect::<LEAF, ANY, PLAIN>(ray, wray, count, t_max, filter),
+            |block| {
+                block.intersect_culled::<LEAF, ANY, PLAIN>(ray, wray, count, t_max, culled, filter)
+            },
         );
         if let Some(h) = hit {
             if ANY {
@@ -273,6 +377,27 @@ where
         }
     }
     best
+}
+
+/// The root's box test of `ray` with kernel `K` within `t_box` (the children entered
+/// and where) and its watertight constants; `None` for a ray that is not finite. (AVX2
+/// takes [`setup::root_setup`], the same bits for fewer instructions.)
+///
+/// # Safety
+/// The CPU must support `K`.
+#[inline(always)]
+unsafe fn root_setup<K: BoxTest>(
+    ray: &Ray,
+    planes: &Planes8,
+    t_box: f32,
+) -> Option<(u32, [f32; 8], WatertightRay)> {
+    let r8 = Ray8::new(ray);
+    if !r8.finite {
+        return None;
+    }
+    let wray = WatertightRay::from_recip(ray, r8.inv_d);
+    let (hits, t_near) = K::hit8(&K::prepare(&r8), planes, t_box);
+    Some((hits, t_near, wray))
 }
 
 /// The lane of `mask` with the least `t` (never NaN: the box test's entry distances),
@@ -290,4 +415,107 @@ pub(super) fn nearest(mask: u32, t: &[f32; 8]) -> usize {
         }
     }
     best
+}
+
+#[cfg(test)]
+mod tests {
+    use glam::Vec3;
+
+    use super::*;
+    use crate::accel::{accept_all, Shape};
+
+    /// Three clusters of four triangles and a sphere amid them, far apart: a root over
+    /// a leaf a cluster, with free lanes. Each sphere's box goes to a free lane and
+    /// encloses the sphere with a margin; a ray that passes far from every sphere culls
+    /// them all, one aimed at a sphere's centre keeps it, and both find the traversal's
+    /// hits.
+    #[test]
+    fn sphere_boxes_fill_free_lanes_and_cull_only_missed_spheres() {
+        let mut shapes = Vec::new();
+        let centres = [
+            Vec3::ZERO,
+            Vec3::new(6.0, 0.0, 6.0),
+            Vec3::new(0.0, 6.0, -6.0),
+        ];
+        for c in centres {
+            for k in 0..4 {
+                let z = k as f32 * 0.3;
+                shapes.push(Shape::Triangle([
+                    c + Vec3::new(-1.0, -1.0, z),
+                    c + Vec3::new(1.0, -1.0, z),
+                    c + Vec3::new(0.0, 1.0, z),
+                ]));
+            }
+            shapes.push(Shape::Sphere {
+                center: c + Vec3::new(0.0, 0.0, 0.45),
+                radius: 0.25,
+            });
+        }
+        let accel = Accel::build(&shapes, |_| false);
+        let root = accel.small.root.as_deref().expect("a tree of one node");
+        let Leaves::Inline(blocks) = &accel.leaves else {
+            panic!("inline leaves")
+        };
+        let mut boxed = 0;
+        for lane in 0..8 {
+            let (boxes, spheres) = (root.sphere_boxes[lane], root.spheres[lane]);
+            assert_eq!(boxes.count_ones(), spheres.count_ones(), "lane {lane}");
+            assert_eq!(boxes as u32 & root.leaves, 0, "a leaf's lane holds a box");
+            if root.leaves & 1 << lane == 0 {
+                continue;
+            }
+            let count = root.node.count[lane] as u32;
+            let block = &blocks[root.node.child[lane] as usize];
+            let mut at = boxes as u32;
+            for (sphere, centre, radius) in block.spheres(count) {
+                assert!(
+                    spheres & 1 << sphere != 0,
+                    "lane {lane}: sphere {sphere} unboxed"
+                );
+                let b = at.trailing_zeros() as usize;
+                at &= at - 1;
+                for axis in 0..3 {
+                    let (lo, hi) = (
+                        root.node.planes[2 * axis][b],
+                        root.node.planes[2 * axis + 1][b],
+                    );
+                    assert!(lo < centre[axis] - radius && hi > centre[axis] + radius);
+                    assert!(hi - lo < 2.0 * radius + 0.2, "box {b} too wide");
+                }
+                boxed += 1;
+            }
+        }
+        assert_eq!(boxed, 3);
+
+        let traversal = accel.clone().without_shortcut();
+        let query = |ray: &Ray| {
+            let r8 = Ray8::new(ray);
+            // SAFETY: the scalar kernel runs on every CPU.
+            let (hits, _) = unsafe {
+                ScalarBoxes::hit8(&ScalarBoxes::prepare(&r8), &root.node.planes, f32::INFINITY)
+            };
+            (0..8)
+                .filter(|&l| root.leaves & 1 << l != 0)
+                .map(|l| root.missed_spheres(l, hits).count_ones())
+                .sum::<u32>()
+        };
+        // Along -z through the first cluster's triangles, outside every sphere's box
+        // (half-width about 0.28): all three culled.
+        let past = Ray::new(Vec3::new(0.5, -0.5, 5.0), -Vec3::Z);
+        assert_eq!(query(&past), 3);
+        // At the first sphere, between the triangles' planes: it stays, and the hit is
+        // the sphere's.
+        let at = Ray::new(Vec3::new(-5.0, 0.0, 0.45), Vec3::X);
+        assert_eq!(query(&at), 2);
+        for ray in [past, at] {
+            let (a, b) = (
+                accel.intersect(&ray, f32::INFINITY, accept_all),
+                traversal.intersect(&ray, f32::INFINITY, accept_all),
+            );
+            assert_eq!(a, b);
+            assert!(a.is_some());
+        }
+        let hit = accel.intersect(&at, f32::INFINITY, accept_all).unwrap();
+        assert_eq!(hit.prim, 4);
+    }
 }

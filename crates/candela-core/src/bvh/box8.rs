@@ -16,7 +16,7 @@ pub type Planes8 = [[f32; 8]; 6];
 /// Robustness factor on far distances (pbrt-v4 §6.8.2), as in `Aabb::hit`. It is folded
 /// into the far planes' reciprocal direction: one more rounding, well inside the 2γ₃
 /// (≈ 3.6·10⁻⁷ relative) margin.
-const FAR_SCALE: f32 = 1.0 + 2.0 * gamma(3);
+pub(crate) const FAR_SCALE: f32 = 1.0 + 2.0 * gamma(3);
 
 /// Traversal widens `t_max` by this factor before box tests. A box's entry distance is
 /// rounded, and a triangle test's distance is rounded more (its barycentric sums cancel

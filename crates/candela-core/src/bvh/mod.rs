@@ -22,7 +22,7 @@ mod quant8;
 mod wide;
 
 pub use binary::{Bvh, BvhNode, SahCost};
-pub(crate) use box8::finite;
+pub(crate) use box8::{finite, FAR_SCALE};
 pub use box8::{hit8_scalar, BoxTest, Planes8, Ray8, ScalarBoxes, Simd, T_MAX_SCALE};
 #[cfg(target_arch = "x86_64")]
 pub use box8::{Avx2Boxes, SseBoxes};
