@@ -8,7 +8,9 @@
 # 4 spp, seed 0, 2 threads, to PFM; the light-heavy scenes again under the `power`, `bvh`
 # and `ris` light samplers and solid-angle lamp sampling; the Cornell box under every MIS
 # mode, sampler and ISA copy; a Gaussian-filtered scene under filter importance sampling
-# (its default is splatting); and one render with AOV layers (EXR).
+# (its default is splatting); and one render with AOV layers (EXR); the splat in the
+# baseline copy, under a tent filter, at 40 spp (passes of two samples) and at 1400 spp
+# (sums folded mid-render).
 # Each pair is compared with `cmp`; where they differ, the maximum absolute and relative
 # pixel difference is printed. Prints one line per case and a last line
 # `ab_images: N cases, M differ`; exits 1 if any differ or fail.
@@ -50,7 +52,7 @@ cases=0 differ=0
 run_case() {
     local name=$1 ext=$2 scene=$3
     shift 3
-    local args=(render "$scene" --res 64x48 --spp 4 --seed 0 --threads 2 "$@")
+    local args=(render "$scene" --res 64x48 --spp "${SPP:-4}" --seed 0 --threads 2 "$@")
     cases=$((cases + 1))
     if ! "$old" "${args[@]}" -o "$out/old/$name.$ext" >/dev/null 2>"$out/old/$name.log"; then
         echo "FAIL old  $name ($(tail -1 "$out/old/$name.log"))"
@@ -100,5 +102,16 @@ for isa in baseline auto; do
 done
 run_case "cornell-textured-importance" pfm bench/scenes/cornell-textured.xml --filter-sampling importance
 run_case "cornell-aov" exr scenes/cornell.toml --aov albedo,normal,depth
+# The splat beyond the bundled scenes' Gaussians in the v3 copy: the baseline copy, a tent
+# filter (Mitsuba's default radius, 1 px) in both, and passes of more than one sample.
+tent="$out/cornell-textured-tent.xml"
+sed 's|<rfilter type="gaussian"/>|<rfilter type="tent"/>|' bench/scenes/cornell-textured.xml >"$tent"
+run_case "thin-lens-isa-baseline" pfm bench/scenes/thin-lens.xml --isa baseline
+run_case "cornell-textured-tent" pfm "$tent"
+run_case "cornell-textured-tent-isa-baseline" pfm "$tent" --isa baseline
+SPP=40 run_case "thin-lens-spp40" pfm bench/scenes/thin-lens.xml
+SPP=40 run_case "cornell-textured-tent-spp40" pfm "$tent"
+# Enough samples that the splat folds its pending sums mid-render (every 664 spp here).
+SPP=1400 run_case "thin-lens-spp1400" pfm bench/scenes/thin-lens.xml
 echo "ab_images: $cases cases, $differ differ (images in $out)"
 [ "$differ" -eq 0 ]

@@ -56,8 +56,10 @@ impl Pixel {
     #[inline]
     pub fn count(&mut self, radiance: Vec3) -> bool {
         self.samples += 1;
-        let accepted = radiance.is_finite()
-            && (radiance.abs().max_element() as f64) < crate::exact_sum::MAX_CONTRIBUTION;
+        // Each |channel| below the limit, 2⁴⁰ (exact in f32); NaN fails the comparison.
+        let limit = crate::exact_sum::MAX_CONTRIBUTION as f32;
+        let m = radiance.abs();
+        let accepted = (m.x < limit) & (m.y < limit) & (m.z < limit);
         self.rejected += !accepted as u32;
         accepted
     }

@@ -6,16 +6,19 @@
 //! but a pixel averages about as many samples as the filter covers pixels, so at equal
 //! spp it is less noisy.
 //!
-//! Determinism: a work item (a band of rows) splats into a block of its own holding its
-//! rows and an apron of rows above and below as far as the filter reaches; the blocks are
-//! then added into the film one after another in the order of their bands. So every pixel
-//! sums the same numbers in the same order whatever the thread count or the order in
-//! which the bands ran.
+//! Determinism: a work item (a band of rows) counts each sample in its own pixel of the
+//! film and splats its shares into a block of its own holding its rows and an apron of
+//! rows above and below as far as the filter reaches. The blocks keep their shares from
+//! pass to pass as exact integer sums and are added into the film when the render ends
+//! (or when their sums near capacity). Integer sums do not depend on their order, so
+//! every pixel gets the same bits whatever the thread count or the order in which the
+//! bands ran.
 //!
 //! Cost: a Gaussian of radius 2 spreads a sample over 16 pixels, four exact sums each.
 //! A block therefore collects its shares in [`LimbSums`] (in the v3 copy of the render
-//! loop, one pixel's four shares at a time in AVX2) and folds them into its pixels when
-//! its band is done: integer sums, so the same bits as adding each share to the pixel.
+//! loop, a row of four pixels' shares at a time in AVX2, some ten instructions a pixel)
+//! and folds them into the film's pixels once: integer sums, so the same bits as adding
+//! each share to the pixel.
 
 use std::ops::Range;
 use std::sync::atomic::Ordering;
@@ -26,8 +29,6 @@ use rayon::prelude::*;
 use crate::film::{Film, Pixel};
 use crate::filter::PixelFilter;
 use crate::integrator::{render_band, Band, PassCtx, RenderStats, SampleSink};
-#[cfg(target_arch = "x86_64")]
-use crate::limb_sums::add_weighted_avx2;
 use crate::limb_sums::LimbSums;
 use crate::options::Isa;
 use crate::sampler::Sampler;
@@ -35,67 +36,127 @@ use crate::sampler::Sampler;
 /// Rows of samples per work item; its block holds the apron besides.
 const BAND_ROWS: u32 = 8;
 
-/// Renders one pass (sample indices `pass` of every pixel) into `film` by splatting.
-pub(crate) fn render_pass<S: Sampler>(
-    ctx: &PassCtx,
-    sampler: &S,
-    film: &mut Film,
-    pass: &Range<u32>,
-) -> RenderStats {
-    let (w, h) = (film.width, film.height);
-    let filter = &ctx.scene.filter;
-    let apron = apron_rows(filter.radius());
-    // A pixel takes at most one share of each sample within the apron's reach per axis.
-    let reach = 2 * apron as u64 + 1;
-    let limbs = reach * reach * pass.len() as u64 <= LimbSums::CAPACITY;
-    let bands: Vec<Range<u32>> = (0..h)
-        .step_by(BAND_ROWS as usize)
-        .map(|y0| y0..(y0 + BAND_ROWS).min(h))
-        .collect();
-    let blocks: Vec<(SplatBlock, RenderStats)> = bands
-        .into_par_iter()
-        .map(|rows| {
-            let y0 = rows.start.saturating_sub(apron);
-            let y1 = (rows.end + apron).min(h);
-            let len = (w * (y1 - y0)) as usize;
-            let mut block = SplatBlock {
-                filter,
-                width: w,
-                height: h,
-                y0,
-                pixels: vec![Pixel::default(); len],
-                limbs: vec![LimbSums::default(); if limbs { len } else { 0 }],
-                isa: ctx.isa,
-            };
-            if ctx.cancel.load(Ordering::Relaxed) {
-                return (block, RenderStats::default());
-            }
-            let done = rows.len() as u64 * w as u64 * pass.len() as u64;
-            let band = Band {
-                rows,
-                width: w,
-                pass: pass.clone(),
-            };
-            let mut sampler = sampler.clone();
-            let stats = render_band(ctx.scene, ctx.isa, &mut sampler, band, &mut block);
-            for (sums, pixel) in block.limbs.iter_mut().zip(&mut block.pixels) {
-                sums.fold_into(pixel);
-            }
-            block.limbs = Vec::new();
-            (ctx.progress)(done);
-            (block, stats)
-        })
-        .collect();
-    let mut stats = RenderStats::default();
-    for (block, s) in blocks {
-        let start = (block.y0 * w) as usize;
-        for (a, b) in film.pixels[start..].iter_mut().zip(&block.pixels) {
-            a.merge(b);
+/// A render's splatted shares: each band's block, kept from pass to pass.
+pub(crate) struct Splats {
+    blocks: Vec<Block>,
+    /// A bound on the shares any pixel of a block has taken since the last fold.
+    pending: u64,
+    /// A bound on the shares a pixel takes per sample index of a pass.
+    per_sample: u64,
+}
+
+/// A band's pending shares: rows from `y0`, the band's and its apron's.
+struct Block {
+    y0: u32,
+    shares: Shares,
+}
+
+/// Where a block's shares wait for the film.
+enum Shares {
+    /// Exact sums in limbs (see [`crate::limb_sums`]).
+    Limbs(LimbSums),
+    /// Pixels' exact sums directly (sample counts unused): for filters so wide that one
+    /// pass could exceed the limbs' capacity.
+    Pixels(Vec<Pixel>),
+}
+
+impl Splats {
+    /// Empty blocks for a `width` × `height` film under `filter`, for passes of at most
+    /// `pass_spp` samples per pixel.
+    pub(crate) fn new(filter: &PixelFilter, width: u32, height: u32, pass_spp: u32) -> Splats {
+        let apron = apron_rows(filter.radius());
+        // A pixel takes at most one share of each sample within the apron's reach per axis.
+        let reach = 2 * apron as u64 + 1;
+        let per_sample = reach * reach;
+        let limbs = per_sample * pass_spp as u64 <= LimbSums::CAPACITY;
+        let blocks = (0..height)
+            .step_by(BAND_ROWS as usize)
+            .map(|y| {
+                let y0 = y.saturating_sub(apron);
+                let y1 = (y + BAND_ROWS + apron).min(height);
+                let len = (width * (y1 - y0)) as usize;
+                let shares = if limbs {
+                    Shares::Limbs(LimbSums::new(len))
+                } else {
+                    Shares::Pixels(vec![Pixel::default(); len])
+                };
+                Block { y0, shares }
+            })
+            .collect();
+        Splats {
+            blocks,
+            pending: 0,
+            per_sample,
         }
-        stats.paths += s.paths;
-        stats.rays += s.rays;
     }
-    stats
+
+    /// Renders one pass (sample indices `pass` of every pixel): the samples are counted in
+    /// `film` and their shares wait in the blocks ([`Self::fold_into`]).
+    pub(crate) fn render_pass<S: Sampler>(
+        &mut self,
+        ctx: &PassCtx,
+        sampler: &S,
+        film: &mut Film,
+        pass: &Range<u32>,
+    ) -> RenderStats {
+        let added = self.per_sample * pass.len() as u64;
+        if self.pending + added > LimbSums::CAPACITY {
+            self.fold_into(film);
+        }
+        self.pending += added;
+        let (w, h) = (film.width, film.height);
+        let filter = &ctx.scene.filter;
+        film.pixels
+            .par_chunks_mut((w * BAND_ROWS).max(1) as usize)
+            .zip(self.blocks.par_iter_mut())
+            .enumerate()
+            .map(|(band, (own, block))| {
+                if ctx.cancel.load(Ordering::Relaxed) {
+                    return RenderStats::default();
+                }
+                let y = band as u32 * BAND_ROWS;
+                let rows = y..y + (own.len() / w as usize) as u32;
+                let done = rows.len() as u64 * w as u64 * pass.len() as u64;
+                let band = Band {
+                    rows: rows.clone(),
+                    width: w,
+                    pass: pass.clone(),
+                };
+                let mut sink = SplatSink {
+                    filter,
+                    radius: filter.radius(),
+                    width: w,
+                    height: h,
+                    own,
+                    own_y0: rows.start,
+                    block,
+                    isa: ctx.isa,
+                };
+                let mut sampler = sampler.clone();
+                let stats = render_band(ctx.scene, ctx.isa, &mut sampler, band, &mut sink);
+                (ctx.progress)(done);
+                stats
+            })
+            .reduce(RenderStats::default, RenderStats::add)
+    }
+
+    /// Adds the blocks' pending shares into `film`'s pixels and clears them: when the
+    /// render ends, and before the limbs could exceed their capacity.
+    pub(crate) fn fold_into(&mut self, film: &mut Film) {
+        for block in &mut self.blocks {
+            let start = (block.y0 * film.width) as usize;
+            match &mut block.shares {
+                Shares::Limbs(sums) => sums.fold_into(&mut film.pixels[start..start + sums.len()]),
+                Shares::Pixels(pixels) => {
+                    for (a, b) in film.pixels[start..].iter_mut().zip(pixels.iter_mut()) {
+                        a.merge(b);
+                        *b = Pixel::default();
+                    }
+                }
+            }
+        }
+        self.pending = 0;
+    }
 }
 
 /// Rows beyond a band that its samples can reach with a filter of radius `r`: a sample
@@ -113,67 +174,84 @@ fn footprint(x: f32, r: f32, n: u32) -> Range<u32> {
     (lo.max(0) as u32)..(hi.clamp(0, n as i64) as u32)
 }
 
-/// A work item's share of the film: rows from `y0`, the band's and its apron's.
-struct SplatBlock<'a> {
+/// A work item's view of the film for one pass: its own rows' pixels, where it counts
+/// its samples, and its block, where their shares go.
+struct SplatSink<'a> {
     filter: &'a PixelFilter,
+    /// The filter's radius, read once.
+    radius: f32,
     width: u32,
     /// The image's height, which clips the footprint.
     height: u32,
-    y0: u32,
-    pixels: Vec<Pixel>,
-    /// Shares pending for `pixels` (empty where a pass could exceed their capacity: the
-    /// shares then go to the pixels directly).
-    limbs: Vec<LimbSums>,
+    /// The film's pixels of the band's rows, from row `own_y0`.
+    own: &'a mut [Pixel],
+    own_y0: u32,
+    block: &'a mut Block,
     /// The render loop's copy, which says whether the shares are added in AVX2.
     isa: Isa,
 }
 
-impl SampleSink for SplatBlock<'_> {
+impl SampleSink for SplatSink<'_> {
     const SPLATS: bool = true;
 
     /// Inlined into each copy of the render loop: in the v3 copy its floors and ceilings
-    /// are single instructions and the AVX2 row is inlined, not called.
+    /// are single instructions.
     #[inline(always)]
     fn add(&mut self, p: UVec2, film_pos: Vec2, l: Vec3) {
-        let (y0, width) = (self.y0, self.width);
-        let row = move |y: u32| ((y - y0) * width) as usize;
-        if !self.pixels[row(p.y) + p.x as usize].count(l) {
+        let own = ((p.y - self.own_y0) * self.width + p.x) as usize;
+        if !self.own[own].count(l) {
             return;
         }
-        let r = self.filter.radius();
-        let xs = footprint(film_pos.x, r, self.width);
         #[cfg(target_arch = "x86_64")]
-        if matches!(self.isa, Isa::V3) && !self.limbs.is_empty() {
-            let ys = footprint(film_pos.y, r, self.height);
-            // SAFETY: the render loop runs its v3 copy only where the CPU has it.
-            if unsafe { self.add_in_lanes(xs.clone(), ys, film_pos, l) } {
-                return;
+        if matches!(self.isa, Isa::V3) {
+            let film = (self.width, self.height, self.radius);
+            if let Shares::Limbs(sums) = &mut self.block.shares {
+                // SAFETY: the render loop runs its v3 copy only where the CPU has it.
+                if unsafe { add_in_lanes(sums, self.filter, film, self.block.y0, film_pos, l) } {
+                    return;
+                }
             }
         }
-        // At most 2⌈r⌉ + 1 weights per axis; a wider filter is computed per pixel.
-        let mut wx = [0.0f32; 16];
-        if xs.len() > wx.len() || self.limbs.is_empty() {
-            return self.add_per_pixel(film_pos, l);
+        let xs = footprint(film_pos.x, self.radius, self.width);
+        let ys = footprint(film_pos.y, self.radius, self.height);
+        self.add_shares(xs, ys, film_pos, l);
+    }
+}
+
+impl SplatSink<'_> {
+    /// [`SampleSink::add`]'s shares one by one, each weight computed as the AVX2 rows
+    /// compute it (a row's x weights once where they fit a cache).
+    fn add_shares(&mut self, xs: Range<u32>, ys: Range<u32>, film_pos: Vec2, l: Vec3) {
+        let filter = self.filter;
+        let axis = |q: u32, pos: f32| filter.eval_axis(q as f32 + 0.5 - pos);
+        let mut cache = [0.0f32; 16];
+        let cached = xs.len() <= cache.len();
+        if cached {
+            for (w, x) in cache.iter_mut().zip(xs.clone()) {
+                *w = axis(x, film_pos.x);
+            }
         }
-        let wx = &mut wx[..xs.len()];
-        for (w, x) in wx.iter_mut().zip(xs.clone()) {
-            *w = self.filter.eval_axis(x as f32 + 0.5 - film_pos.x);
-        }
-        for y in footprint(film_pos.y, r, self.height) {
-            let wy = self.filter.eval_axis(y as f32 + 0.5 - film_pos.y);
+        for y in ys {
+            let wy = axis(y, film_pos.y);
+            // A zero weight adds nothing: its shares are zero.
             if wy == 0.0 {
                 continue;
             }
-            let start = row(y) + xs.start as usize;
-            let sums = &mut self.limbs[start..start + xs.len()];
-            match self.isa {
-                // SAFETY: the render loop runs its v3 copy only where the CPU has it.
-                #[cfg(target_arch = "x86_64")]
-                Isa::V3 => unsafe { add_row_avx2(sums, l, wx, wy) },
-                // A zero weight adds nothing: its shares are zero.
-                _ => {
-                    for (s, &wx) in sums.iter_mut().zip(wx.iter()) {
-                        s.add_weighted(l, wx * wy);
+            let row = ((y - self.block.y0) * self.width) as usize;
+            for (k, x) in xs.clone().enumerate() {
+                let wx = if cached {
+                    cache[k]
+                } else {
+                    axis(x, film_pos.x)
+                };
+                if wx == 0.0 {
+                    continue;
+                }
+                let i = row + x as usize;
+                match &mut self.block.shares {
+                    Shares::Limbs(sums) => sums.add_weighted(i, l, wx * wy),
+                    Shares::Pixels(pixels) => {
+                        pixels[i].add_weighted(l, wx * wy);
                     }
                 }
             }
@@ -181,93 +259,106 @@ impl SampleSink for SplatBlock<'_> {
     }
 }
 
-impl SplatBlock<'_> {
-    /// [`SampleSink::add`]'s shares for a footprint of at most 4 × 4 pixels (a Gaussian
-    /// of radius ≤ 2, Mitsuba's default) in AVX2: the 4 + 4 axis weights in one
-    /// [`PixelFilter::eval_axis8`], a row's 4 products in one multiply, each pixel's four
-    /// shares in one [`add_weighted_avx2`]. The same numbers as the scalar path. Returns
-    /// false, adding nothing, where the footprint or the filter does not fit it.
-    ///
-    /// # Safety
-    /// The CPU must have AVX2 and FMA.
-    #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx,avx2,fma")]
-    #[inline]
-    fn add_in_lanes(&mut self, xs: Range<u32>, ys: Range<u32>, film_pos: Vec2, l: Vec3) -> bool {
-        use std::arch::x86_64::*;
-        if xs.len() > 4 || ys.len() > 4 {
-            return false;
-        }
-        // Lanes 0‥3: the pixels xs.start + i; lanes 4‥7: ys.start + i (exact integers),
-        // offset as `eval_axis`'s callers offset them: (q + ½) − film_pos.
-        let lane = _mm256_setr_ps(0.0, 1.0, 2.0, 3.0, 0.0, 1.0, 2.0, 3.0);
-        let first = _mm256_set_m128(_mm_set1_ps(ys.start as f32), _mm_set1_ps(xs.start as f32));
-        let pos = _mm256_set_m128(_mm_set1_ps(film_pos.y), _mm_set1_ps(film_pos.x));
-        let offsets = _mm256_sub_ps(
-            _mm256_add_ps(_mm256_add_ps(first, lane), _mm256_set1_ps(0.5)),
-            pos,
-        );
-        let Some(w) = self.filter.eval_axis8(offsets) else {
-            return false;
-        };
-        let wx = _mm256_castps256_ps128(w);
-        let mut wy = [0.0f32; 4];
-        // SAFETY: `wy` holds four f32.
-        unsafe { _mm_storeu_ps(wy.as_mut_ptr(), _mm256_extractf128_ps::<1>(w)) };
-        let rgb1 = crate::limb_sums::rgb1(l);
-        for (y, &wy) in ys.zip(&wy) {
-            // A zero weight adds nothing: its shares are zero.
-            if wy == 0.0 {
-                continue;
-            }
-            // The row's weights wx·wy, rounded to f32 as the scalar path rounds them.
-            let mut weights = [0.0f64; 4];
-            // SAFETY: `weights` holds four f64.
-            unsafe {
-                _mm256_storeu_pd(
-                    weights.as_mut_ptr(),
-                    _mm256_cvtps_pd(_mm_mul_ps(wx, _mm_set1_ps(wy))),
-                )
-            };
-            let start = ((y - self.y0) * self.width + xs.start) as usize;
-            let sums = &mut self.limbs[start..start + xs.len()];
-            for (s, w) in sums.iter_mut().zip(&weights) {
-                add_weighted_avx2(s, rgb1, _mm256_broadcast_sd(w));
-            }
-        }
-        true
-    }
-
-    /// [`SampleSink::add`]'s shares straight into the pixels, each filter weight computed
-    /// where it is used: for filters too wide for the per-axis cache and the limbs.
-    fn add_per_pixel(&mut self, film_pos: Vec2, l: Vec3) {
-        let r = self.filter.radius();
-        let xs = footprint(film_pos.x, r, self.width);
-        for y in footprint(film_pos.y, r, self.height) {
-            let wy = self.filter.eval_axis(y as f32 + 0.5 - film_pos.y);
-            if wy == 0.0 {
-                continue;
-            }
-            let start = ((y - self.y0) * self.width) as usize;
-            for x in xs.clone() {
-                let wx = self.filter.eval_axis(x as f32 + 0.5 - film_pos.x);
-                if wx != 0.0 {
-                    self.pixels[start + x as usize].add_weighted(l, wx * wy);
-                }
-            }
-        }
-    }
-}
-
-/// One row of a sample's shares, `l` × `wx[i]` × `wy` into `sums[i]`, in AVX2.
+/// [`SampleSink::add`]'s shares for a footprint of at most 4 × 4 pixels (a Gaussian
+/// of radius ≤ 2, Mitsuba's default; a tent of radius ≤ 1.5) in AVX2, into `sums` of the
+/// block whose rows start at `y0` of a film `width` × `height` under a filter of radius
+/// `r`: both axes' footprints in one register, the 4 + 4 axis weights in one
+/// [`PixelFilter::eval_axis8`] (or one by one for other filters), and the shares by
+/// [`LimbSums::add_4x4_avx2`] (rows by [`LimbSums::add_row_avx2`] where the footprint is
+/// clipped). The same numbers as [`footprint`] and [`SplatSink::add_shares`]. Returns
+/// false, adding nothing, where the footprint does not fit.
+///
+/// # Safety
+/// The CPU must have AVX2 and FMA.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx,avx2,fma")]
-fn add_row_avx2(sums: &mut [LimbSums], l: Vec3, wx: &[f32], wy: f32) {
-    let rgb1 = crate::limb_sums::rgb1(l);
-    for (s, &wx) in sums.iter_mut().zip(wx) {
-        let w = std::arch::x86_64::_mm256_set1_pd((wx * wy) as f64);
-        add_weighted_avx2(s, rgb1, w);
+#[inline]
+fn add_in_lanes(
+    sums: &mut LimbSums,
+    filter: &PixelFilter,
+    (width, height, r): (u32, u32, f32),
+    y0: u32,
+    film_pos: Vec2,
+    l: Vec3,
+) -> bool {
+    use std::arch::x86_64::*;
+    let (xs, ys, bounds) = footprints_in_lanes(film_pos, r, (width, height));
+    if xs.len() > 4 || ys.len() > 4 {
+        return false;
     }
+    // Lanes 0‥3: the pixels xs.start + i; lanes 4‥7: ys.start + i (exact integers),
+    // offset as `add_shares` offsets them: (q + ½) − film_pos.
+    let lane = _mm256_setr_ps(0.0, 1.0, 2.0, 3.0, 0.0, 1.0, 2.0, 3.0);
+    let first = _mm256_set_m128(
+        _mm_permute_ps::<0x55>(bounds),
+        _mm_permute_ps::<0x00>(bounds),
+    );
+    let pos = _mm256_set_m128(_mm_set1_ps(film_pos.y), _mm_set1_ps(film_pos.x));
+    let offsets = _mm256_sub_ps(
+        _mm256_add_ps(_mm256_add_ps(first, lane), _mm256_set1_ps(0.5)),
+        pos,
+    );
+    let w = filter.eval_axis8(offsets).unwrap_or_else(|| {
+        let mut x = [0.0f32; 8];
+        // SAFETY: `x` holds eight f32, as does the array loaded.
+        unsafe {
+            _mm256_storeu_ps(x.as_mut_ptr(), offsets);
+            _mm256_loadu_ps(x.map(|x| filter.eval_axis(x)).as_ptr())
+        }
+    });
+    let (wx, wy) = (_mm256_castps256_ps128(w), _mm256_extractf128_ps::<1>(w));
+    let rgb1 = crate::limb_sums::rgb1(l);
+    let start = ((ys.start - y0) * width + xs.start) as usize;
+    if xs.len() == 4 && ys.len() == 4 {
+        // A row of zero weights adds zero shares: no need to skip it.
+        sums.add_4x4_avx2((start, width as usize), rgb1, wx, wy);
+        return true;
+    }
+    let mut wy_lanes = [0.0f32; 4];
+    // SAFETY: `wy_lanes` holds four f32.
+    unsafe { _mm_storeu_ps(wy_lanes.as_mut_ptr(), wy) };
+    for (j, &wy) in wy_lanes.iter().enumerate().take(ys.len()) {
+        // A zero weight adds nothing: its shares are zero.
+        if wy == 0.0 {
+            continue;
+        }
+        // The row's weights wx·wy, rounded to f32 as the scalar path rounds them.
+        let weights = _mm256_cvtps_pd(_mm_mul_ps(wx, _mm_set1_ps(wy)));
+        sums.add_row_avx2(start + j * width as usize, xs.len(), rgb1, weights);
+    }
+    true
+}
+
+/// [`footprint`] along both axes in one SSE register, lanes (x, y, x, y): (x − ½ − r)
+/// floored plus one, then (x − ½ + r) ceiled, clamped at 0 and the ends at the image's
+/// size (exact integers below 2²⁴, as the scalar i64s are). Returns the x and y
+/// footprints and the register (first x, first y, end x, end y).
+///
+/// # Safety
+/// The CPU must have AVX2 and FMA.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx,avx2,fma")]
+#[inline]
+fn footprints_in_lanes(
+    film_pos: Vec2,
+    r: f32,
+    (width, height): (u32, u32),
+) -> (Range<u32>, Range<u32>, std::arch::x86_64::__m128) {
+    use std::arch::x86_64::*;
+    let pos = _mm_setr_ps(film_pos.x, film_pos.y, film_pos.x, film_pos.y);
+    let centred = _mm_sub_ps(pos, _mm_set1_ps(0.5));
+    let radius = _mm_set1_ps(r);
+    let lo = _mm_add_ps(_mm_floor_ps(_mm_sub_ps(centred, radius)), _mm_set1_ps(1.0));
+    let hi = _mm_ceil_ps(_mm_add_ps(centred, radius));
+    let size = _mm_setr_ps(f32::MAX, f32::MAX, width as f32, height as f32);
+    let bounds = _mm_min_ps(
+        _mm_max_ps(_mm_blend_ps::<0b1100>(lo, hi), _mm_setzero_ps()),
+        size,
+    );
+    let mut b = [0i32; 4];
+    // SAFETY: `b` holds four i32.
+    unsafe { _mm_storeu_si128(b.as_mut_ptr() as *mut __m128i, _mm_cvttps_epi32(bounds)) };
+    (b[0] as u32..b[2] as u32, b[1] as u32..b[3] as u32, bounds)
 }
 
 #[cfg(test)]
@@ -291,5 +382,35 @@ mod tests {
         }
         assert_eq!(footprint(0.2, 2.0, 3), 0..2);
         assert_eq!(footprint(0.2, 2.0, 1), 0..1);
+    }
+
+    /// The v3 splat's footprints are `footprint`'s, inside the image, at its edges and
+    /// beyond them, at pixel corners and centres (exact halves) and between.
+    #[cfg(target_arch = "x86_64")]
+    #[test]
+    fn footprints_in_lanes_are_the_scalar_ones() {
+        if !(std::arch::is_x86_feature_detected!("avx2")
+            && std::arch::is_x86_feature_detected!("fma"))
+        {
+            return;
+        }
+        let (w, h) = (37u32, 5u32);
+        for r in [0.5f32, 1.0, 1.5, 2.0, 2.3, 7.9] {
+            for k in 0..=40 * 64 {
+                let x = k as f32 / 64.0 - 1.0;
+                let y = (k * 7 % (8 * 64)) as f32 / 64.0 - 1.5;
+                let p = Vec2::new(x, y);
+                // SAFETY: the CPU has AVX2 and FMA (checked above).
+                let (xs, ys, _) = unsafe { footprints_in_lanes(p, r, (w, h)) };
+                assert_eq!(xs.len(), footprint(x, r, w).len(), "r {r} x {x}");
+                if !xs.is_empty() {
+                    assert_eq!(xs, footprint(x, r, w), "r {r} x {x}");
+                }
+                assert_eq!(ys.len(), footprint(y, r, h).len(), "r {r} y {y}");
+                if !ys.is_empty() {
+                    assert_eq!(ys, footprint(y, r, h), "r {r} y {y}");
+                }
+            }
+        }
     }
 }

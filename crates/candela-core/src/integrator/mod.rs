@@ -49,7 +49,8 @@ pub struct RenderStats {
 }
 
 impl RenderStats {
-    fn add(self, o: RenderStats) -> RenderStats {
+    /// The stats of two disjoint sets of paths together.
+    pub(crate) fn add(self, o: RenderStats) -> RenderStats {
         RenderStats {
             paths: self.paths + o.paths,
             rays: self.rays + o.rays,

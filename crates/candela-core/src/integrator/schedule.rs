@@ -43,16 +43,17 @@ pub fn render_with<S: Sampler>(
     let mut start = samples.start;
     let splat = scene.settings.filter_sampling == FilterSampling::Splat
         && !matches!(scene.filter, PixelFilter::Box);
+    let mut splats = splat.then(|| crate::splat::Splats::new(&scene.filter, w, h, pass_spp));
     while start < samples.end && !cancel.load(Ordering::Relaxed) {
         let pass = start..(start + pass_spp).min(samples.end);
-        if splat {
+        if let Some(splats) = &mut splats {
             let ctx = PassCtx {
                 scene,
                 isa,
                 cancel,
                 progress,
             };
-            stats = stats.add(crate::splat::render_pass(&ctx, &sampler, &mut film, &pass));
+            stats = stats.add(splats.render_pass(&ctx, &sampler, &mut film, &pass));
             start = pass.end;
             continue;
         }
@@ -84,6 +85,9 @@ pub fn render_with<S: Sampler>(
             .reduce(RenderStats::default, RenderStats::add);
         stats = stats.add(pass_stats);
         start = pass.end;
+    }
+    if let Some(mut splats) = splats {
+        splats.fold_into(&mut film);
     }
     let cancelled = film.pixels.iter().any(|p| p.samples < spp);
     RenderResult {
