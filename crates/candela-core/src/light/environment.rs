@@ -181,7 +181,8 @@ impl LightSource for EnvironmentLight {
             (EnvironmentMap::Equirect(m), _) => m.sample(u)?,
             (EnvironmentMap::Cubemap(m), _) => m.sample(u)?,
         };
-        let wi = (self.world_from_map * s.dir).normalize();
+        // A rotation of a unit vector: unit to rounding, as the maps' directions are.
+        let wi = self.world_from_map * s.dir;
         Some(LightSample {
             radiance: self.strength * s.radiance,
             wi,

@@ -124,17 +124,23 @@ impl Equirect {
         Vec2::new(if x < 0.0 { x + 1.0 } else { x }, uv.y)
     }
 
+    /// The grid vertices at the corners of the cell of column `k`, row `j`: top left,
+    /// top right, bottom left, bottom right. One bounds check for the four.
+    #[inline]
+    fn cell(&self, k: usize, j: usize) -> [Vec4; 4] {
+        let stride = self.image.width + 1;
+        let i = j * stride + k;
+        let c = &self.grid[i..i + stride + 2];
+        [c[0], c[1], c[stride], c[stride + 1]]
+    }
+
     /// Radiance and sampling function, blended at grid point `p`.
     #[inline]
     fn lookup(&self, p: Vec2) -> Vec4 {
         let (k, s) = GridAxis::Even(self.image.width).locate(p.x);
         let (j, t) = GridAxis::Centred(self.image.height).locate(p.y);
-        let stride = self.image.width + 1;
-        let i = j * stride + k;
-        let g = &self.grid;
-        let top = g[i].lerp(g[i + 1], s);
-        let bottom = g[i + stride].lerp(g[i + stride + 1], s);
-        top.lerp(bottom, t)
+        let c = self.cell(k, j);
+        c[0].lerp(c[1], s).lerp(c[2].lerp(c[3], s), t)
     }
 
     /// Bilinearly filtered radiance towards unit direction `d`.
@@ -160,10 +166,7 @@ impl Equirect {
     /// point within it, its radiance and its density from the cell's four grid vertices.
     pub fn sample(&self, u: Vec2) -> Option<MapSample> {
         let (k, j, rest) = self.distribution.sample_cell(u)?;
-        let stride = self.image.width + 1;
-        let i = j * stride + k;
-        let g = &self.grid;
-        let (g00, g10, g01, g11) = (g[i], g[i + 1], g[i + stride], g[i + stride + 1]);
+        let [g00, g10, g01, g11] = self.cell(k, j);
         let st = sample_bilinear(rest, [g00.w, g10.w, g01.w, g11.w]);
         let c = g00.lerp(g10, st.x).lerp(g01.lerp(g11, st.x), st.y);
         let p = self.distribution.cell_point(k, j, st);
