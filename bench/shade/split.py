@@ -32,8 +32,7 @@ STAGES = [
     ("lights", ["/light/", "candela_core::light"]),
     ("BSDF+texture", ["/bsdf/", "material.rs", "texture.rs", "candela_core::bsdf",
                       "candela_core::material", "candela_core::texture"]),
-    ("path loop", ["/integrator/", "candela_core::integrator", "sampling.rs", "/sampling/",
-                   "math.rs"]),
+    ("path loop", ["/integrator/", "candela_core::integrator", "sampling.rs", "math.rs"]),
     ("scheduling", ["rayon", "candela_core::splat::render_pass"]),
 ]
 

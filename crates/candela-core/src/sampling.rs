@@ -9,11 +9,6 @@ use std::f32::consts::{FRAC_1_PI, FRAC_PI_4, PI};
 
 use glam::{Vec2, Vec3};
 
-mod alias_rows;
-
-use alias_rows::vose_bins;
-pub use alias_rows::AliasRows;
-
 /// Shirley–Chiu concentric map from the square to the unit disk (area-preserving up to
 /// the factor π).
 #[inline]
@@ -198,20 +193,38 @@ impl AliasTable {
             return None;
         }
         let n = weights.len();
+        let mut bins: Vec<AliasBin> = weights
+            .iter()
+            .map(|&w| AliasBin {
+                q: 0.0,
+                alias: 0,
+                pmf: (w as f64 / total) as f32,
+            })
+            .collect();
         // Scaled probabilities p·n: below 1 the bin is under-full and takes an alias.
         let mut scaled: Vec<f64> = weights
             .iter()
             .map(|&w| w as f64 / total * n as f64)
             .collect();
-        let bins = vose_bins(&mut scaled)
-            .into_iter()
-            .zip(weights)
-            .map(|(b, &w)| AliasBin {
-                q: b.q,
-                alias: b.alias,
-                pmf: (w as f64 / total) as f32,
-            })
-            .collect();
+        let (mut small, mut large): (Vec<usize>, Vec<usize>) =
+            (0..n).partition(|&i| scaled[i] < 1.0);
+        // Peek at both lists before taking from either: popping `small` first would lose
+        // its last entry (with q = 0) whenever round-off empties `large` first.
+        while let (Some(&s), Some(&l)) = (small.last(), large.last()) {
+            small.pop();
+            bins[s].q = scaled[s] as f32;
+            bins[s].alias = l as u32;
+            scaled[l] -= 1.0 - scaled[s];
+            if scaled[l] < 1.0 {
+                large.pop();
+                small.push(l);
+            }
+        }
+        // What remains is full up to round-off.
+        for i in small.into_iter().chain(large) {
+            bins[i].q = 1.0;
+            bins[i].alias = i as u32;
+        }
         Some(AliasTable { bins, total })
     }
 
