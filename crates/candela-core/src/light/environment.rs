@@ -11,7 +11,7 @@ use super::envmap::{Cubemap, Equirect, MapSample};
 use super::{LightBounds, LightFlags, LightSample, LightSource, ShadingCtx, SkyImportance};
 use crate::geometry::Ray;
 use crate::math::luminance;
-use crate::sampling::sample_uniform_sphere;
+use crate::sampling::{sample_uniform_sphere, UNIFORM_SPHERE_PDF};
 
 /// What the environment looks like, in its native frame.
 #[derive(Clone, Debug)]
@@ -83,7 +83,11 @@ impl EnvironmentLight {
 
     /// Radiance arriving along `-d` from direction `d` (world space, unit).
     pub fn eval(&self, d: Vec3) -> Vec3 {
-        self.strength * self.eval_local(self.map_from_world * d)
+        match &self.map {
+            // The same everywhere: no rotation into the map's frame.
+            EnvironmentMap::Constant(c) => self.strength * *c,
+            _ => self.strength * self.eval_local(self.map_from_world * d),
+        }
     }
 
     /// The map's radiance towards `local` (the map's frame, unit), strength not applied.
@@ -150,9 +154,11 @@ impl LightSource for EnvironmentLight {
         self.eval(ray.d.normalize())
     }
 
-    /// The equirect map's radiance and density from one lookup of its grid.
+    /// The equirect map's radiance and density from one lookup of its grid; a constant
+    /// map's without normalising or rotating the direction.
     fn le_pdf(&self, ctx: &ShadingCtx, ray: &Ray) -> (Vec3, f32) {
         match (&self.map, self.sampling) {
+            (EnvironmentMap::Constant(c), _) => (self.strength * *c, UNIFORM_SPHERE_PDF),
             (EnvironmentMap::Equirect(m), EnvironmentSampling::Importance) => {
                 let (l, pdf) = m.eval_pdf(self.map_from_world * ray.d.normalize());
                 (self.strength * l, pdf)
@@ -175,7 +181,8 @@ impl LightSource for EnvironmentLight {
             (EnvironmentMap::Equirect(m), _) => m.sample(u)?,
             (EnvironmentMap::Cubemap(m), _) => m.sample(u)?,
         };
-        let wi = (self.world_from_map * s.dir).normalize();
+        // A rotation of a unit vector: unit to rounding, as the maps' directions are.
+        let wi = self.world_from_map * s.dir;
         Some(LightSample {
             radiance: self.strength * s.radiance,
             wi,
@@ -188,13 +195,13 @@ impl LightSource for EnvironmentLight {
     }
 
     fn pdf_li(&self, _ctx: &ShadingCtx, wi: Vec3) -> f32 {
-        let local = self.map_from_world * wi.normalize();
+        let local = || self.map_from_world * wi.normalize();
         match (&self.map, self.sampling) {
             (EnvironmentMap::Constant(_), _) | (_, EnvironmentSampling::Uniform) => {
-                1.0 / (4.0 * PI)
+                UNIFORM_SPHERE_PDF
             }
-            (EnvironmentMap::Equirect(m), _) => m.pdf(local),
-            (EnvironmentMap::Cubemap(m), _) => m.pdf(local),
+            (EnvironmentMap::Equirect(m), _) => m.pdf(local()),
+            (EnvironmentMap::Cubemap(m), _) => m.pdf(local()),
         }
     }
 

@@ -1,17 +1,21 @@
 //! A density on the unit square proportional to a function known at the vertices of a
-//! grid and interpolated bilinearly between them, sampled exactly: the continuous
-//! `Marginal2D` of Mitsuba 3 (`distr_2d.h`), with rows that need not be evenly spaced.
+//! grid and interpolated bilinearly between them, sampled exactly: the density of
+//! Mitsuba 3's continuous `Marginal2D` (`distr_2d.h`), with rows that need not be evenly
+//! spaced, drawn in two discrete steps and one continuous one.
 //!
-//! The marginal density of y, ∫ f(x, y) dx, is linear between two vertex rows (the
-//! integral of a bilinear function over x is linear in y), so y is drawn by inverting a
-//! piecewise-linear CDF. Given y, f(·, y) is piecewise linear in x, and its running
-//! integral is the same blend of the two vertex rows' running integrals, so x is drawn
-//! the same way without building anything per sample. Both inversions are monotone, so
-//! stratified numbers stay stratified.
+//! A grid cell's share of ∫ f is its area times the mean of its four corners (f is
+//! bilinear within it). So the row of cells is drawn in proportion to the row's mass, the
+//! cell within that row in proportion to its own mass (each by a guide table over the
+//! discrete CDF, [`Distribution1D::sample_cell`]: a lookup and on average under two steps),
+//! and the point within the cell with the bilinear density through its corners
+//! ([`sample_bilinear`]). The product of the three is f / ∫ f everywhere, the same density
+//! as inverting the continuous marginal and conditional CDFs, for a fraction of the work:
+//! no blended CDFs, no second lookup. Every step is monotone (y in u.y, x in u.x within a
+//! row), so stratified numbers stay stratified.
 
 use glam::Vec2;
 
-use crate::sampling::{sample_linear, ONE_MINUS_EPSILON};
+use crate::sampling::{sample_bilinear, Distribution1D, ONE_MINUS_EPSILON};
 
 /// `n` as an `f32`: the value of `n as f32`, for the grid sizes here (below 2³²), by way
 /// of `u32`, whose conversion on x86-64 is one instruction where `usize`'s tests the sign
@@ -101,67 +105,15 @@ pub struct Bilinear2D {
     stride: usize,
     /// The function at the vertices, row-major (non-negative).
     values: Vec<f32>,
-    /// For each vertex row, ∫₀^{x_k} f(x, y_row) dx at each vertex column k.
-    row_cdf: Vec<f32>,
-    /// ∫₀^{y_j} ∫₀¹ f dx dy at each vertex row j.
-    marginal_cdf: Vec<f32>,
-    /// Guide to `marginal_cdf`: one entry per row cell, and one more.
-    marginal_guide: Vec<u32>,
-    /// Guides to each vertex row's `row_cdf`: `ROW_GUIDE + 1` entries a row.
-    row_guides: Vec<u32>,
+    /// The rows of cells, by each row's share of ∫ f.
+    rows: Distribution1D,
+    /// Per row of cells, its cells by their shares of the row's mass.
+    cells: Vec<Distribution1D>,
     /// [`GridAxis::position`] of every vertex of each axis, looked up by the sampling
     /// rather than computed (a match on the axis, a conversion and a division each).
     x_positions: Vec<f32>,
     y_positions: Vec<f32>,
     integral: f32,
-}
-
-/// Parts of a vertex row's mass its guide marks.
-const ROW_GUIDE: usize = 64;
-
-/// For a non-decreasing `cdf` over `cells` cells (`cells + 1` entries from 0), entry g
-/// of `parts + 1` is the last cell k with cdf[k] ≤ g/parts of the total.
-fn guide(cdf: &[f32], parts: usize) -> Vec<u32> {
-    let cells = cdf.len() - 1;
-    let total = cdf[cells];
-    let mut k = 0;
-    (0..=parts)
-        .map(|g| {
-            let threshold = total * (g as f32 / parts as f32);
-            while k + 1 < cells && cdf[k + 1] <= threshold {
-                k += 1;
-            }
-            k as u32
-        })
-        .collect()
-}
-
-/// The last cell k < `cells` with cdf(k) ≤ `target` (cdf(0) = 0 ≤ target), by binary
-/// search between the guesses `lo` and `hi` (cdf(lo) ≤ target < cdf(hi)), widened to
-/// the whole range where either does not hold.
-#[inline]
-fn last_at_or_below(
-    cdf: impl Fn(usize) -> f32,
-    target: f32,
-    cells: usize,
-    lo: usize,
-    hi: usize,
-) -> usize {
-    let mut lo = if cdf(lo) <= target { lo } else { 0 };
-    let mut hi = if hi > lo && hi < cells && cdf(hi) > target {
-        hi
-    } else {
-        cells
-    };
-    while hi - lo > 1 {
-        let mid = (lo + hi) / 2;
-        if cdf(mid) <= target {
-            lo = mid;
-        } else {
-            hi = mid;
-        }
-    }
-    lo
 }
 
 impl Bilinear2D {
@@ -171,30 +123,24 @@ impl Bilinear2D {
         let (stride, rows) = (x_axis.vertices(), y_axis.vertices());
         assert_eq!(values.len(), stride * rows, "one value per vertex");
         let values: Vec<f32> = values.into_iter().map(|v| v.max(0.0)).collect();
-        let mut row_cdf = Vec::with_capacity(values.len());
-        let mut row_integrals = Vec::with_capacity(rows);
-        for row in values.chunks_exact(stride) {
-            let mut acc = 0.0f64;
-            row_cdf.push(0.0);
-            for k in 0..stride - 1 {
-                let width = (x_axis.position(k + 1) - x_axis.position(k)) as f64;
-                acc += 0.5 * (row[k] as f64 + row[k + 1] as f64) * width;
-                row_cdf.push(acc as f32);
-            }
-            row_integrals.push(acc);
-        }
-        let mut marginal_cdf = Vec::with_capacity(rows);
-        let mut acc = 0.0f64;
-        marginal_cdf.push(0.0);
-        for j in 0..rows - 1 {
+        // Each cell's mass: its area times the mean of its corners.
+        let (columns, cell_rows) = (stride - 1, rows - 1);
+        let mut cell_mass = Vec::with_capacity(columns * cell_rows);
+        for j in 0..cell_rows {
             let height = (y_axis.position(j + 1) - y_axis.position(j)) as f64;
-            acc += 0.5 * (row_integrals[j] + row_integrals[j + 1]) * height;
-            marginal_cdf.push(acc as f32);
+            for k in 0..columns {
+                let width = (x_axis.position(k + 1) - x_axis.position(k)) as f64;
+                let i = j * stride + k;
+                let corners = [i, i + 1, i + stride, i + stride + 1]
+                    .map(|i| values[i] as f64)
+                    .iter()
+                    .sum::<f64>();
+                cell_mass.push(0.25 * corners * width * height);
+            }
         }
-        let marginal_guide = guide(&marginal_cdf, rows - 1);
-        let row_guides = row_cdf
-            .chunks_exact(stride)
-            .flat_map(|row| guide(row, ROW_GUIDE))
+        let row_mass: Vec<f64> = cell_mass
+            .chunks_exact(columns)
+            .map(|row| row.iter().sum())
             .collect();
         let positions = |axis: GridAxis| (0..axis.vertices()).map(|k| axis.position(k)).collect();
         Bilinear2D {
@@ -202,13 +148,14 @@ impl Bilinear2D {
             y_axis,
             stride,
             values,
-            row_cdf,
-            marginal_cdf,
-            marginal_guide,
-            row_guides,
+            rows: Distribution1D::new(&row_mass.iter().map(|&m| m as f32).collect::<Vec<_>>()),
+            cells: cell_mass
+                .chunks_exact(columns)
+                .map(|row| Distribution1D::new(&row.iter().map(|&m| m as f32).collect::<Vec<_>>()))
+                .collect(),
             x_positions: positions(x_axis),
             y_positions: positions(y_axis),
-            integral: acc as f32,
+            integral: row_mass.iter().sum::<f64>() as f32,
         }
     }
 
@@ -245,59 +192,42 @@ impl Bilinear2D {
         }
     }
 
-    /// A point of [0, 1)² drawn with density ∝ f, and that density; `None` when f is
+    /// A cell drawn with probability ∝ its share of ∫ f, as (column k, row j), and two
+    /// numbers uniform on [0, 1)² left for placing the point within it; `None` when f is
     /// zero everywhere.
-    pub fn sample(&self, u: Vec2) -> Option<(Vec2, f32)> {
+    #[inline]
+    pub fn sample_cell(&self, u: Vec2) -> Option<(usize, usize, Vec2)> {
         if self.integral <= 0.0 {
             return None;
         }
-        // The row cell, from the marginal: linear from one vertex row's integral to the
-        // next's.
-        let target = u.y * self.integral;
-        let m = &self.marginal_cdf;
-        let cells = m.len() - 1;
-        let g = cell_index(u.y * size_f32(cells)).min(cells - 1);
-        let (lo, hi) = (self.marginal_guide[g], self.marginal_guide[g + 1] + 1);
-        let j = last_at_or_below(|j| m[j], target, cells, lo as usize, hi as usize);
-        let xi = unit_within(m[j], m[j + 1], target);
-        let row_integral = |j: usize| self.row_cdf[(j + 1) * self.stride - 1];
-        let t = sample_linear(xi, row_integral(j), row_integral(j + 1));
-        let (y0, y1) = (self.y_positions[j], self.y_positions[j + 1]);
-        let y = (y0 + t * (y1 - y0)).min(ONE_MINUS_EPSILON);
+        let (j, rest_y) = self.rows.sample_cell(u.y);
+        let (k, rest_x) = self.cells[j].sample_cell(u.x);
+        Some((k, j, Vec2::new(rest_x, rest_y)))
+    }
 
-        // The column cell, from f(·, y)'s running integral: the blend of the two vertex
-        // rows' running integrals.
-        let top = &self.row_cdf[j * self.stride..(j + 1) * self.stride];
-        let bottom = &self.row_cdf[(j + 1) * self.stride..(j + 2) * self.stride];
-        let cdf = |k: usize| top[k] + t * (bottom[k] - top[k]);
-        let cells = self.stride - 1;
-        let target = u.x * cdf(cells);
-        let g = cell_index(u.x * ROW_GUIDE as f32).min(ROW_GUIDE - 1);
-        let guides = &self.row_guides[j * (ROW_GUIDE + 1)..(j + 2) * (ROW_GUIDE + 1)];
-        let (top_guide, bottom_guide) = guides.split_at(ROW_GUIDE + 1);
-        let lo = top_guide[g].min(bottom_guide[g]) as usize;
-        let hi = top_guide[g + 1].max(bottom_guide[g + 1]) as usize + 1;
-        let k = last_at_or_below(cdf, target, cells, lo, hi);
-        let xi = unit_within(cdf(k), cdf(k + 1), target);
+    /// The point at (`st.x`, `st.y`) within the cell of column `k`, row `j`, in [0, 1)².
+    #[inline]
+    pub fn cell_point(&self, k: usize, j: usize, st: Vec2) -> Vec2 {
+        let (x0, x1) = (self.x_positions[k], self.x_positions[k + 1]);
+        let (y0, y1) = (self.y_positions[j], self.y_positions[j + 1]);
+        Vec2::new(
+            (x0 + st.x * (x1 - x0)).min(ONE_MINUS_EPSILON),
+            (y0 + st.y * (y1 - y0)).min(ONE_MINUS_EPSILON),
+        )
+    }
+
+    /// A point of [0, 1)² drawn with density ∝ f, and that density; `None` when f is
+    /// zero everywhere.
+    pub fn sample(&self, u: Vec2) -> Option<(Vec2, f32)> {
+        let (k, j, rest) = self.sample_cell(u)?;
         let i = j * self.stride + k;
         let v = &self.values;
-        let f0 = v[i] + t * (v[i + self.stride] - v[i]);
-        let f1 = v[i + 1] + t * (v[i + self.stride + 1] - v[i + 1]);
-        let s = sample_linear(xi, f0, f1);
-        let (x0, x1) = (self.x_positions[k], self.x_positions[k + 1]);
-        let x = (x0 + s * (x1 - x0)).min(ONE_MINUS_EPSILON);
-        let f = f0 + s * (f1 - f0);
-        (f > 0.0).then(|| (Vec2::new(x, y), f / self.integral))
-    }
-}
-
-/// Where `target` lies between `c0` and `c1`, in [0, 1); 0 for an empty interval.
-#[inline]
-fn unit_within(c0: f32, c1: f32, target: f32) -> f32 {
-    if c1 > c0 {
-        ((target - c0) / (c1 - c0)).clamp(0.0, ONE_MINUS_EPSILON)
-    } else {
-        0.0
+        let st = sample_bilinear(
+            rest,
+            [v[i], v[i + 1], v[i + self.stride], v[i + self.stride + 1]],
+        );
+        let f = self.value_in_cell(k, st.x, j, st.y);
+        (f > 0.0).then(|| (self.cell_point(k, j, st), f / self.integral))
     }
 }
 
@@ -367,57 +297,37 @@ mod tests {
         }
     }
 
-    /// [`Bilinear2D::sample`]'s searches without the guides: plain binary searches.
-    fn unguided_cells(d: &Bilinear2D, u: Vec2) -> (usize, usize) {
-        let full = |cdf: &dyn Fn(usize) -> f32, target, cells| {
-            last_at_or_below(cdf, target, cells, 0, cells)
-        };
-        let m = &d.marginal_cdf;
-        let j = full(&|j| m[j], u.y * d.integral, m.len() - 1);
-        let xi = unit_within(m[j], m[j + 1], u.y * d.integral);
-        let row = |j: usize| d.row_cdf[(j + 1) * d.stride - 1];
-        let t = sample_linear(xi, row(j), row(j + 1));
-        let (top, bottom) = (&d.row_cdf[j * d.stride..], &d.row_cdf[(j + 1) * d.stride..]);
-        let cdf = |k: usize| top[k] + t * (bottom[k] - top[k]);
-        let cells = d.stride - 1;
-        (j, full(&cdf, u.x * cdf(cells), cells))
-    }
-
     #[test]
-    fn guided_searches_find_the_cells_binary_searches_find() {
-        // A 257 × 130 grid with a bright spot, empty stretches and a ramp, and 2·10⁵
-        // samples: the guided sample's cells are the plain searches' cells.
-        let (w, h) = (257, 130);
-        let mut values = vec![0.0f32; w * h];
-        for (i, v) in values.iter_mut().enumerate() {
-            let (x, y) = (i % w, i / w);
-            *v = match (x / 40, y / 30) {
-                (1, _) | (_, 2) => 0.0,
-                _ => 0.1 + (x as f32 / w as f32) * ((i * 7919) % 13) as f32,
-            };
-            if (120..124).contains(&x) && (60..63).contains(&y) {
-                *v = 5e4;
+    fn cells_are_drawn_in_proportion_to_their_mass() {
+        // A 9 × 7 grid with zeros, a spike and uneven rows: the tables' probability of
+        // each cell (row times cell within the row) is the cell's exact mass over ∫ f.
+        let (xa, ya) = (GridAxis::Even(8), GridAxis::Centred(5));
+        let values: Vec<f32> = (0..xa.vertices() * ya.vertices())
+            .map(|i| [0.0, 1.0, 4.0, 0.5, 0.0, 2.5, 9.0, 300.0][i * 5 % 8])
+            .collect();
+        let d = Bilinear2D::new(values.clone(), xa, ya);
+        let stride = xa.vertices();
+        let mut total = 0.0;
+        for j in 0..ya.vertices() - 1 {
+            for k in 0..stride - 1 {
+                let i = j * stride + k;
+                let mean = (values[i] + values[i + 1] + values[i + stride] + values[i + stride + 1])
+                    as f64
+                    / 4.0;
+                let area = ((xa.position(k + 1) - xa.position(k))
+                    * (ya.position(j + 1) - ya.position(j))) as f64;
+                let exact = mean * area / d.integral() as f64;
+                let (rows, cells) = (d.rows.len() as f64, d.cells[j].len() as f64);
+                let table =
+                    d.rows.cell_pdf(j) as f64 / rows * d.cells[j].cell_pdf(k) as f64 / cells;
+                assert!(
+                    (table - exact).abs() < 1e-6,
+                    "cell ({k}, {j}): {table} vs {exact}"
+                );
+                total += table;
             }
         }
-        let d = Bilinear2D::new(values, GridAxis::Even(w - 1), GridAxis::Centred(h - 2));
-        let mut state = 0x9e37_79b9u32;
-        let mut next = || {
-            state ^= state << 13;
-            state ^= state >> 17;
-            state ^= state << 5;
-            (state >> 8) as f32 / (1u32 << 24) as f32
-        };
-        for _ in 0..200_000 {
-            let u = Vec2::new(next(), next());
-            let (p, _) = d.sample(u).expect("positive there");
-            let (j, k) = unguided_cells(&d, u);
-            let (x0, x1) = (d.x_axis.position(k), d.x_axis.position(k + 1));
-            let (y0, y1) = (d.y_axis.position(j), d.y_axis.position(j + 1));
-            assert!(
-                (x0..=x1).contains(&p.x) && (y0..=y1).contains(&p.y),
-                "{u}: {p}"
-            );
-        }
+        assert!((total - 1.0).abs() < 1e-6);
     }
 
     #[test]

@@ -7,7 +7,7 @@ use glam::{Vec2, Vec3, Vec4};
 use super::bilinear::{Bilinear2D, GridAxis};
 use super::{compensated, Image, MapSample};
 use crate::math::{atan2_poly, luminance};
-use crate::sampling::sin_cos_quarter_turns;
+use crate::sampling::{sample_bilinear, sin_cos_quarter_turns};
 
 /// A panorama in the native mapping of [`super`]: y up, centre along −z.
 ///
@@ -29,6 +29,9 @@ pub struct Equirect {
     distribution: Box<Bilinear2D>,
     /// Half a texel's width in u, 0.5 / width: where the grid's columns start.
     half_texel: f32,
+    /// The distribution's integral times 2π²: the solid-angle density is the grid's
+    /// sampling function over this and sin θ.
+    integral_solid_angle: f32,
 }
 
 /// Image coordinates (u right, v down, both in \[0, 1\]) of a unit direction.
@@ -107,6 +110,7 @@ impl Equirect {
         ));
         Equirect {
             half_texel: 0.5 / w as f32,
+            integral_solid_angle: distribution.integral() * UV_TO_SOLID_ANGLE,
             image,
             grid,
             distribution,
@@ -120,17 +124,23 @@ impl Equirect {
         Vec2::new(if x < 0.0 { x + 1.0 } else { x }, uv.y)
     }
 
+    /// The grid vertices at the corners of the cell of column `k`, row `j`: top left,
+    /// top right, bottom left, bottom right. One bounds check for the four.
+    #[inline]
+    fn cell(&self, k: usize, j: usize) -> [Vec4; 4] {
+        let stride = self.image.width + 1;
+        let i = j * stride + k;
+        let c = &self.grid[i..i + stride + 2];
+        [c[0], c[1], c[stride], c[stride + 1]]
+    }
+
     /// Radiance and sampling function, blended at grid point `p`.
     #[inline]
     fn lookup(&self, p: Vec2) -> Vec4 {
         let (k, s) = GridAxis::Even(self.image.width).locate(p.x);
         let (j, t) = GridAxis::Centred(self.image.height).locate(p.y);
-        let stride = self.image.width + 1;
-        let i = j * stride + k;
-        let g = &self.grid;
-        let top = g[i].lerp(g[i + 1], s);
-        let bottom = g[i + stride].lerp(g[i + stride + 1], s);
-        top.lerp(bottom, t)
+        let c = self.cell(k, j);
+        c[0].lerp(c[1], s).lerp(c[2].lerp(c[3], s), t)
     }
 
     /// Bilinearly filtered radiance towards unit direction `d`.
@@ -143,9 +153,8 @@ impl Equirect {
     pub fn eval_pdf(&self, d: Vec3) -> (Vec3, f32) {
         let (uv, sin_theta) = direction_to_uv_sin(d);
         let c = self.lookup(self.grid_point(uv));
-        let integral = self.distribution.integral();
-        let pdf = if sin_theta > 0.0 && integral > 0.0 {
-            c.w / (integral * UV_TO_SOLID_ANGLE * sin_theta)
+        let pdf = if sin_theta > 0.0 && self.integral_solid_angle > 0.0 {
+            c.w / (self.integral_solid_angle * sin_theta)
         } else {
             0.0
         };
@@ -153,19 +162,24 @@ impl Equirect {
     }
 
     /// A direction drawn with density ∝ the luminance of the radiance (the grid's bilinear
-    /// approximation of it): see [`Equirect`].
+    /// approximation of it): see [`Equirect`]. The cell comes from the distribution; the
+    /// point within it, its radiance and its density from the cell's four grid vertices.
     pub fn sample(&self, u: Vec2) -> Option<MapSample> {
-        let (p, pdf_grid) = self.distribution.sample(u)?;
+        let (k, j, rest) = self.distribution.sample_cell(u)?;
+        let [g00, g10, g01, g11] = self.cell(k, j);
+        let st = sample_bilinear(rest, [g00.w, g10.w, g01.w, g11.w]);
+        let c = g00.lerp(g10, st.x).lerp(g01.lerp(g11, st.x), st.y);
+        let p = self.distribution.cell_point(k, j, st);
         let x = p.x + self.half_texel;
         let uv = Vec2::new(if x >= 1.0 { x - 1.0 } else { x }, p.y);
         let (dir, sin_theta) = uv_to_direction_sin(uv);
-        if sin_theta <= 0.0 {
+        if sin_theta <= 0.0 || c.w <= 0.0 {
             return None;
         }
         Some(MapSample {
             dir,
-            pdf: pdf_grid / (UV_TO_SOLID_ANGLE * sin_theta),
-            radiance: self.lookup(p).truncate(),
+            pdf: c.w / (self.integral_solid_angle * sin_theta),
+            radiance: c.truncate(),
         })
     }
 
