@@ -212,6 +212,9 @@ mod tests {
         (sx, sy)
     }
 
+    /// A unit-slope sampler: (cos θ, sin θ, u) to (x̃, ỹ).
+    type SlopeSampler = fn(f32, f32, Vec2) -> (f32, f32);
+
     /// The exact CDFs, in f64 with `libm`'s erf, at a sampled slope (x̃, ỹ) seen from θ:
     /// F(x̃) along the view (see [`sample_unit_slope`]) and (1 + erf ỹ)/2 across.
     fn exact_cdfs(cos_theta: f32, sin_theta: f32, (x, y): (f32, f32)) -> (f64, f64) {
@@ -244,8 +247,7 @@ mod tests {
             let sin_theta = (1.0 - cos_theta * cos_theta).max(0.0).sqrt();
             let u = Vec2::new(uniform(), uniform());
             let (ux, uy) = (u.x.max(1e-6) as f64, u.y.max(1e-6) as f64);
-            let samplers: [fn(f32, f32, Vec2) -> (f32, f32); 2] =
-                [sample_unit_slope, sample_unit_slope_libm];
+            let samplers: [SlopeSampler; 2] = [sample_unit_slope, sample_unit_slope_libm];
             for (w, sample) in worst.iter_mut().zip(samplers) {
                 let (fx, fy) = exact_cdfs(cos_theta, sin_theta, sample(cos_theta, sin_theta, u));
                 let err = (fx - ux).abs().max((fy - uy).abs());
