@@ -12,6 +12,7 @@ use std::f32::consts::PI;
 use glam::{Vec2, Vec3};
 
 pub mod beckmann;
+mod special;
 
 pub use beckmann::Beckmann;
 
