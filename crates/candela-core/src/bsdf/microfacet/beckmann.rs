@@ -7,7 +7,7 @@
 //! Mitsuba evaluates: the sampler draws from the exact density of visible normals (its
 //! CDF is written with erf), so a pdf built from the fit would disagree with it by up to
 //! a few tenths of a percent, which a chi-square test of 4·10⁵ samples can see. Both
-//! write erfc(x) as e^(−x²) erfcx(x) ([`special::erfcx`], 3·10⁻⁷ relative), sharing the
+//! write erfc(x) as e^(−x²) erfcx(x) (`special::erfcx`, 3·10⁻⁷ relative), sharing the
 //! exponential their formulas already hold.
 
 use std::f32::consts::{FRAC_2_SQRT_PI, PI};
