@@ -476,12 +476,16 @@ impl Block {
             .mul(sz.mul(a_z))
             .add(v.mul(sz.mul(b_z)))
             .add(ww.mul(sz.mul(c_z)));
+        // The determinant's sign moved onto the distance (exact sign flips): a comparison
+        // with zero and one with `t_max · |det|`, the scalar test's two pairs chosen by
+        // `det`'s sign in fewer operations and with the same outcome (see there).
+        let sign = det.and(V::splat(-0.0));
+        let det_abs = det.xor(sign);
+        let t_signed = t_scaled.xor(sign);
         let t_max_v = V::splat(t_max);
-        let limit = t_max_v.mul(det);
-        let bad_neg = det.lt(zero).and(t_scaled.ge(zero).or(t_scaled.lt(limit)));
-        let bad_pos = det.gt(zero).and(t_scaled.le(zero).or(t_scaled.gt(limit)));
-        let rejected = mixed_signs.or(det.eq(zero)).or(bad_neg.or(bad_pos));
-        if !ANY && !rejected.bits() & tris | on_edge | sphere_bits == 0 {
+        let before = t_signed.gt(t_max_v.mul(det_abs)).andnot(t_signed.gt(zero));
+        let passed = mixed_signs.andnot(before);
+        if !ANY && passed.bits() & tris | on_edge | sphere_bits == 0 {
             // Every lane is rejected before the division, as in the scalar test (for a
             // shadow ray, whose blocks are hit more often, the check costs more than it
             // saves: callgrind, any-hit instructions per ray on the room 468 -> 480).
@@ -490,7 +494,7 @@ impl Block {
         let inv_det = V::splat(1.0).div(det);
         let t = t_scaled.mul(inv_det);
         let in_range = t.gt(zero).and(t.lt(t_max_v));
-        let hit = rejected.andnot(in_range).bits() & !on_edge;
+        let hit = passed.and(in_range).bits() & !on_edge;
         let hit = if MIXED { hit & !sph | sphere_bits } else { hit };
         if hit | on_edge == 0 {
             return (0, 0);

@@ -28,11 +28,11 @@ pub trait Wide: Copy {
     unsafe fn max(self, o: Self) -> Self;
     unsafe fn and(self, o: Self) -> Self;
     unsafe fn or(self, o: Self) -> Self;
+    unsafe fn xor(self, o: Self) -> Self;
     /// `!self & o`.
     unsafe fn andnot(self, o: Self) -> Self;
     unsafe fn eq(self, o: Self) -> Self;
     unsafe fn lt(self, o: Self) -> Self;
-    unsafe fn le(self, o: Self) -> Self;
     unsafe fn gt(self, o: Self) -> Self;
     unsafe fn ge(self, o: Self) -> Self;
     /// Bit `i` set where lane `i` is true.
@@ -98,6 +98,10 @@ impl Wide for __m128 {
         _mm_or_ps(self, o)
     }
     #[inline(always)]
+    unsafe fn xor(self, o: Self) -> Self {
+        _mm_xor_ps(self, o)
+    }
+    #[inline(always)]
     unsafe fn andnot(self, o: Self) -> Self {
         _mm_andnot_ps(self, o)
     }
@@ -108,10 +112,6 @@ impl Wide for __m128 {
     #[inline(always)]
     unsafe fn lt(self, o: Self) -> Self {
         _mm_cmplt_ps(self, o)
-    }
-    #[inline(always)]
-    unsafe fn le(self, o: Self) -> Self {
-        _mm_cmple_ps(self, o)
     }
     #[inline(always)]
     unsafe fn gt(self, o: Self) -> Self {
@@ -161,10 +161,10 @@ impl Wide for __m256 {
         fn max(self: Self, o: Self) -> Self { _mm256_max_ps(self, o) }
         fn and(self: Self, o: Self) -> Self { _mm256_and_ps(self, o) }
         fn or(self: Self, o: Self) -> Self { _mm256_or_ps(self, o) }
+        fn xor(self: Self, o: Self) -> Self { _mm256_xor_ps(self, o) }
         fn andnot(self: Self, o: Self) -> Self { _mm256_andnot_ps(self, o) }
         fn eq(self: Self, o: Self) -> Self { _mm256_cmp_ps::<_CMP_EQ_OQ>(self, o) }
         fn lt(self: Self, o: Self) -> Self { _mm256_cmp_ps::<_CMP_LT_OQ>(self, o) }
-        fn le(self: Self, o: Self) -> Self { _mm256_cmp_ps::<_CMP_LE_OQ>(self, o) }
         fn gt(self: Self, o: Self) -> Self { _mm256_cmp_ps::<_CMP_GT_OQ>(self, o) }
         fn ge(self: Self, o: Self) -> Self { _mm256_cmp_ps::<_CMP_GE_OQ>(self, o) }
         fn bits(self: Self) -> u32 { _mm256_movemask_ps(self) as u32 }

@@ -540,6 +540,22 @@ impl Accel {
     }
 }
 
+/// The watertight constants of `ray`, whose reciprocal direction is `inv_d`: under the
+/// AVX2 kernel made in registers (`small::setup`), the same bits with no stack round trip
+/// to index the axes (callgrind, INLINE split: many-lights 1121 -> 1107 traversal
+/// instructions a path, glossy-plates 1805 -> 1802, hdr-sky-sun 749 -> 741).
+///
+/// # Safety
+/// The CPU must support `LEAF`.
+#[inline(always)]
+unsafe fn watertight<const LEAF: u8>(ray: &Ray, inv_d: glam::Vec3) -> WatertightRay {
+    #[cfg(target_arch = "x86_64")]
+    if LEAF == block::AVX2 {
+        return small::setup::watertight_from_recip(ray, inv_d);
+    }
+    WatertightRay::from_recip(ray, inv_d)
+}
+
 /// # Safety
 /// The CPU must support `K` and `LEAF`.
 #[inline(always)]
@@ -557,7 +573,7 @@ unsafe fn intersect_tree<
     filter: &impl Fn(u32, &TriangleHit) -> bool,
 ) -> Option<Hit> {
     let r8 = Ray8::new(ray);
-    let wray = WatertightRay::from_recip(ray, r8.inv_d);
+    let wray = watertight::<LEAF>(ray, r8.inv_d);
     let mut best: Option<Hit> = None;
     tree.intersect::<K>(
         &r8,
@@ -615,7 +631,7 @@ unsafe fn occluded_tree<
     filter: &impl Fn(u32, &TriangleHit) -> bool,
 ) -> bool {
     let r8 = Ray8::new(ray);
-    let wray = WatertightRay::from_recip(ray, r8.inv_d);
+    let wray = watertight::<LEAF>(ray, r8.inv_d);
     tree.occluded::<K>(
         &r8,
         t_max,

@@ -13,7 +13,7 @@
 //! and one call: the AVX2 query compiled for AVX2, the others out of line (an
 //! out-of-line dispatch cost 42 instructions a query).
 
-mod setup;
+pub(super) mod setup;
 
 #[cfg(target_arch = "x86_64")]
 use crate::bvh::Avx2Boxes;
@@ -278,7 +278,15 @@ impl SmallQuery for SoleLeaf {
         if !crate::bvh::finite(ray) {
             return None;
         }
-        // The same bits as the traversal's `from_recip` (the same division).
+        // The same bits as the traversal's `from_recip` (the same division); under AVX2
+        // made in registers.
+        #[cfg(target_arch = "x86_64")]
+        let wray = if LEAF == block::AVX2 {
+            setup::watertight_new(ray)
+        } else {
+            WatertightRay::new(ray)
+        };
+        #[cfg(not(target_arch = "x86_64"))]
         let wray = WatertightRay::new(ray);
         let SoleLeaf { leaf, count } = *self;
         leaves.with_block(

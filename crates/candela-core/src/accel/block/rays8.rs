@@ -301,27 +301,18 @@ impl Block {
                 ),
                 _mm256_mul_ps(ww, _mm256_mul_ps(sz, c_z)),
             );
-            let limit = _mm256_mul_ps(t_max, det);
-            let bad_neg = _mm256_and_ps(
-                _mm256_cmp_ps::<_CMP_LT_OQ>(det, zero),
-                _mm256_or_ps(
-                    _mm256_cmp_ps::<_CMP_GE_OQ>(t_scaled, zero),
-                    _mm256_cmp_ps::<_CMP_LT_OQ>(t_scaled, limit),
-                ),
-            );
-            let bad_pos = _mm256_and_ps(
-                _mm256_cmp_ps::<_CMP_GT_OQ>(det, zero),
-                _mm256_or_ps(
-                    _mm256_cmp_ps::<_CMP_LE_OQ>(t_scaled, zero),
-                    _mm256_cmp_ps::<_CMP_GT_OQ>(t_scaled, limit),
-                ),
-            );
-            let rejected = _mm256_or_ps(
-                _mm256_or_ps(mixed_signs, eq0(det)),
-                _mm256_or_ps(bad_neg, bad_pos),
+            let sign = _mm256_and_ps(det, _mm256_set1_ps(-0.0));
+            let det_abs = _mm256_xor_ps(det, sign);
+            let t_signed = _mm256_xor_ps(t_scaled, sign);
+            let before = _mm256_andnot_ps(
+                _mm256_cmp_ps::<_CMP_GT_OQ>(t_signed, _mm256_mul_ps(t_max, det_abs)),
+                _mm256_cmp_ps::<_CMP_GT_OQ>(t_signed, zero),
             );
             let edge = _mm256_movemask_ps(on_edge) as u32;
-            let open = _mm256_andnot_ps(_mm256_or_ps(rejected, on_edge), in_group);
+            let open = _mm256_andnot_ps(
+                _mm256_or_ps(mixed_signs, on_edge),
+                _mm256_and_ps(before, in_group),
+            );
             if _mm256_movemask_ps(open) != 0 {
                 // Some ray of the group passes the tests before the division.
                 let inv_det = _mm256_div_ps(_mm256_set1_ps(1.0), det);

@@ -41,11 +41,7 @@ pub(super) unsafe fn root_setup(
     planes: &Planes8,
     t_box: f32,
 ) -> Option<(u32, [f32; 8], WatertightRay)> {
-    // `Ray` is six floats: the first four, and the last four (o.z, d) turned to d.
-    let p = ray as *const Ray as *const f32;
-    let o = _mm_loadu_ps(p);
-    let d = _mm_loadu_ps(p.add(2));
-    let d = _mm_shuffle_ps::<0b11_11_10_01>(d, d);
+    let (o, d) = ray_lanes(ray);
     // `crate::bvh::finite`: each of x · 0 is ±0 for a finite x and NaN otherwise, so the
     // three sums are zero exactly where each lane is.
     let zero = _mm_setzero_ps();
@@ -82,25 +78,68 @@ pub(super) unsafe fn root_setup(
     let mut entry = [0.0f32; 8];
     _mm256_storeu_ps(entry.as_mut_ptr(), t_near);
 
-    // `WatertightRay::with_sz`: the largest |d| (the first of equals), then the other
-    // two axes, and every per-axis value picked by one permute.
+    Some((hits, entry, watertight(ray, o, d, inv)))
+}
+
+/// `ray`'s watertight constants made in registers from its origin `o` and direction `d`
+/// (x, y, z in the first three lanes) and their reciprocals `inv` (`1/d`, the division
+/// [`WatertightRay::new`] makes): the bits of `WatertightRay::with_sz`, the largest
+/// |d| (the first of equals), then the other two axes, and every per-axis value picked by
+/// one permute (no stack round trips to index the axes).
+///
+/// # Safety
+/// The CPU must support AVX2.
+#[inline]
+#[target_feature(enable = "avx2")]
+pub(crate) unsafe fn watertight(ray: &Ray, o: __m128, d: __m128, inv: __m128) -> WatertightRay {
     let a = Vec3A::from(_mm_andnot_ps(_mm_set1_ps(-0.0), d));
     let y_wins = a.y > a.x;
     let max = if y_wins { a.y } else { a.x };
     let kz = if a.z > max { 2 } else { y_wins as usize };
-    let negative = (_mm_movemask_ps(_mm_cmplt_ps(d, zero)) as usize >> kz) & 1;
+    let negative = (_mm_movemask_ps(_mm_cmplt_ps(d, _mm_setzero_ps())) as usize >> kz) & 1;
     let axes = AXES.get_unchecked(2 * kz + negative);
     let pick = _mm_loadu_si128(axes.as_ptr() as *const __m128i);
     let sz = _mm_permutevar_ps(inv, pick);
     let sz = _mm_shuffle_ps::<0b10_10_10_10>(sz, sz);
     let shear = _mm_blend_ps::<0b0100>(_mm_mul_ps(_mm_permutevar_ps(d, pick), sz), sz);
-    let wray = WatertightRay {
+    WatertightRay {
         o: ray.o,
         kx: axes[0] as usize,
         ky: axes[1] as usize,
         kz,
         shear: Vec3::from(Vec3A::from(shear)),
         o_k: Vec3::from(Vec3A::from(_mm_permutevar_ps(o, pick))),
-    };
-    Some((hits, entry, wray))
+    }
+}
+
+/// [`watertight`] of a ray whose reciprocal direction is `inv_d` (`ray.d.recip()`).
+///
+/// # Safety
+/// The CPU must support AVX2.
+#[inline]
+#[target_feature(enable = "avx2")]
+pub(crate) unsafe fn watertight_from_recip(ray: &Ray, inv_d: Vec3) -> WatertightRay {
+    let (o, d) = ray_lanes(ray);
+    watertight(ray, o, d, Vec3A::from(inv_d).into())
+}
+
+/// [`watertight`] of a ray, its one division made here.
+///
+/// # Safety
+/// The CPU must support AVX2.
+#[inline]
+#[target_feature(enable = "avx2")]
+pub(crate) unsafe fn watertight_new(ray: &Ray) -> WatertightRay {
+    let (o, d) = ray_lanes(ray);
+    watertight(ray, o, d, _mm_div_ps(_mm_set1_ps(1.0), d))
+}
+
+/// `ray`'s origin and direction in the first three lanes of two registers, from two
+/// loads (`Ray` is six floats: the first four, and the last four turned to d).
+#[inline(always)]
+unsafe fn ray_lanes(ray: &Ray) -> (__m128, __m128) {
+    let p = ray as *const Ray as *const f32;
+    let o = _mm_loadu_ps(p);
+    let d = _mm_loadu_ps(p.add(2));
+    (o, _mm_shuffle_ps::<0b11_11_10_01>(d, d))
 }
