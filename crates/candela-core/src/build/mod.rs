@@ -217,6 +217,9 @@ fn build_taking(desc: &SceneDesc, mut taken: Vec<Option<MeshDesc>>) -> Result<Sc
             material.reads_dpdu(),
         );
     }
+    for s in &mut spheres {
+        s.reads_uv = materials[s.material.0 as usize].reads_uv();
+    }
     let mut prims = Vec::with_capacity(triangles + spheres.len());
     for (mi, m) in meshes.iter().enumerate() {
         prims.extend((0..m.indices.len() as u32).map(|tri| Prim::Triangle {

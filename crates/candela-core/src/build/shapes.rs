@@ -70,6 +70,7 @@ pub(super) fn build_sphere(
         material,
         light: None,
         flip_normals: shape.flip_normals,
+        reads_uv: true,
     })
 }
 

@@ -99,23 +99,35 @@ impl Scene {
                     ShadingRecord::Full => world_triangle_interaction(m, tri, t, bary),
                 }
             }
-            Prim::Sphere(i) => self.sphere_interaction(ray, i, t),
+            Prim::Sphere(i) => self.sphere_interaction(ray, i, t, shading),
         }
     }
 
-    /// The hit record of sphere `i` at distance `t` along the ray.
+    /// The hit record of sphere `i` at distance `t` along the ray; where `shading` and
+    /// nothing that shades the sphere reads its uvs ([`super::Sphere::reads_uv`]), they
+    /// are zero.
     #[inline(never)]
-    fn sphere_interaction(&self, ray: &Ray, i: u32, t: f32) -> Option<SurfaceInteraction> {
+    fn sphere_interaction(
+        &self,
+        ray: &Ray,
+        i: u32,
+        t: f32,
+        shading: bool,
+    ) -> Option<SurfaceInteraction> {
         let s = &self.spheres[i as usize];
         let n_out = (ray.at(t) - s.center).normalize();
         // Project back onto the surface to remove the error of o + t·d.
         let p = s.center + n_out * s.radius;
         let n = if s.flip_normals { -n_out } else { n_out };
-        let phi = n_out.z.atan2(n_out.x);
-        let uv = Vec2::new(
-            (phi / std::f32::consts::TAU).rem_euclid(1.0),
-            n_out.y.clamp(-1.0, 1.0).acos() / std::f32::consts::PI,
-        );
+        let uv = if shading && !s.reads_uv {
+            Vec2::ZERO
+        } else {
+            let phi = n_out.z.atan2(n_out.x);
+            Vec2::new(
+                (phi / std::f32::consts::TAU).rem_euclid(1.0),
+                n_out.y.clamp(-1.0, 1.0).acos() / std::f32::consts::PI,
+            )
+        };
         Some(SurfaceInteraction {
             p,
             t,
@@ -478,6 +490,74 @@ mod tests {
         let mut bare = mesh(m.positions.clone(), vec![], m.indices.clone());
         bare.cache_shading_record(true, true);
         assert_eq!(bare.shading_record, ShadingRecord::Bare);
+    }
+
+    /// A sphere's record for shading is the full one, bit for bit, but for the uvs where
+    /// its material reads none (zero there, the inverse trigonometry skipped): a constant
+    /// Lambertian sphere's and a rough conductor's are left out, a checkerboard's kept;
+    /// the build sets [`super::super::Sphere::reads_uv`] from the material.
+    #[test]
+    fn a_sphere_s_shading_record_skips_only_the_uvs_nothing_reads() {
+        use crate::desc::{
+            BsdfDesc, GeometryDesc, MaterialDesc, MicrofacetDesc, SceneDesc, ShapeDesc, TextureDesc,
+        };
+        let checker = TextureDesc::Checker {
+            a: Vec3::splat(0.2),
+            b: Vec3::splat(0.8),
+            uv_transform: glam::Affine2::IDENTITY,
+        };
+        let metal = BsdfDesc::Conductor {
+            eta: Vec3::splat(0.2),
+            k: Vec3::splat(3.0),
+            specular: Vec3::ONE,
+            alpha_u: 0.3,
+            alpha_v: 0.1,
+            distribution: MicrofacetDesc::default(),
+        };
+        let materials = vec![
+            MaterialDesc::diffuse("plain", Vec3::splat(0.5)),
+            MaterialDesc::new("checker", BsdfDesc::Diffuse { albedo: checker }),
+            MaterialDesc::new("metal", metal),
+        ];
+        let shapes = ["plain", "checker", "metal"]
+            .iter()
+            .enumerate()
+            .map(|(i, name)| {
+                let center = Vec3::new(3.0 * i as f32, 0.0, 0.0);
+                ShapeDesc::new(
+                    GeometryDesc::Sphere {
+                        center,
+                        radius: 1.0,
+                    },
+                    *name,
+                )
+            })
+            .collect();
+        let desc = SceneDesc {
+            materials,
+            shapes,
+            ..Default::default()
+        };
+        let scene = crate::build::build(&desc).expect("scene builds");
+        let reads: Vec<_> = scene.spheres.iter().map(|s| s.reads_uv).collect();
+        assert_eq!(reads, [false, true, false]);
+        let mut compared = 0;
+        for (i, &reads_uv) in reads.iter().enumerate() {
+            for (dx, dy) in [(0.1, 0.2), (-0.5, 0.3), (0.6, -0.4), (0.0, 0.0)] {
+                let o = Vec3::new(3.0 * i as f32 + dx, dy, 5.0);
+                let ray = Ray::new(o, Vec3::new(0.01, -0.02, -1.0).normalize());
+                let full = scene.intersect(&ray, f32::INFINITY).expect("hits");
+                let lean = scene
+                    .intersect_for_shading(&ray, f32::INFINITY)
+                    .expect("hits");
+                let uv = if reads_uv { full.uv } else { Vec2::ZERO };
+                assert_ne!(full.uv, Vec2::ZERO);
+                let expected = SurfaceInteraction { uv, ..full };
+                assert_eq!(format!("{lean:?}"), format!("{expected:?}"), "sphere {i}");
+                compared += 1;
+            }
+        }
+        assert_eq!(compared, 12);
     }
 
     #[test]

@@ -183,6 +183,13 @@ pub struct Sphere {
     pub light: Option<LightId>,
     /// Normals point inwards.
     pub flip_normals: bool,
+    /// Whether shading a hit reads its uvs: its material's [`Material::reads_uv`] (a sphere
+    /// light's emission is uniform). Where not, [`super::Scene::intersect_for_shading`]
+    /// leaves them zero and skips their two inverse trigonometric functions. Set by the
+    /// scene's build; `true` reads them always.
+    ///
+    /// [`Material::reads_uv`]: crate::material::Material::reads_uv
+    pub reads_uv: bool,
 }
 
 /// A primitive in the BVH.
