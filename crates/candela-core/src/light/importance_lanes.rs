@@ -103,10 +103,38 @@ impl ImportanceLanes {
     #[target_feature(enable = "avx,avx2")]
     #[inline]
     pub fn importance_avx2(&self, ctx: &ShadingCtx) -> [f32; LANES] {
+        self.loaded().importance(ctx)
+    }
+
+    /// Whether every lane's radius is 0 (point and spot lights): then
+    /// [`Self::importance_of_points_avx2`] gives [`Self::importance`]'s bits.
+    pub fn all_points(&self) -> bool {
+        self.radius.iter().all(|&r| r == 0.0)
+    }
+
+    /// [`Self::importance_avx2`] of lanes that are all points ([`Self::all_points`]), in
+    /// fewer instructions ([`LoadedLanes::importance_of_points`]).
+    ///
+    /// # Safety
+    ///
+    /// The CPU must have AVX2.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx,avx2")]
+    #[inline]
+    pub fn importance_of_points_avx2(&self, ctx: &ShadingCtx) -> [f32; LANES] {
+        debug_assert!(self.all_points());
+        self.loaded().importance_of_points(ctx)
+    }
+
+    /// The lanes in AVX2 registers.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx,avx2")]
+    #[inline]
+    fn loaded(&self) -> LoadedLanes {
         // SAFETY (loads): every array is LANES f32 in a 32-byte aligned struct, at offsets
         // that are multiples of 32.
         let load = |a: &[f32; LANES]| unsafe { _mm256_load_ps(a.as_ptr()) };
-        let lanes = LoadedLanes {
+        LoadedLanes {
             center: [
                 load(&self.center[0]),
                 load(&self.center[1]),
@@ -120,8 +148,7 @@ impl ImportanceLanes {
             cos_theta_e: load(&self.cos_theta_e),
             // SAFETY: as the loads above.
             two_sided: unsafe { _mm256_load_ps(self.two_sided.as_ptr() as *const f32) },
-        };
-        lanes.importance(ctx)
+        }
     }
 }
 
@@ -153,6 +180,27 @@ impl LoadedLanes {
     #[target_feature(enable = "avx,avx2")]
     #[inline]
     pub fn importance(&self, ctx: &ShadingCtx) -> [f32; LANES] {
+        self.evaluate::<false>(ctx)
+    }
+
+    /// [`Self::importance`] where every lane's radius is 0 (point and spot lights), the
+    /// same bits for ~20 fewer instructions: the bounding sphere subtends no cone
+    /// (sin θ_b = 0; cos θ_b = 1, or −1 at the light itself), so θ' = θ_x and the
+    /// receiver's cosine need no sines. `tests` compares it with the scalar code.
+    ///
+    /// # Safety
+    ///
+    /// The CPU must have AVX2.
+    #[target_feature(enable = "avx,avx2")]
+    #[inline]
+    pub fn importance_of_points(&self, ctx: &ShadingCtx) -> [f32; LANES] {
+        self.evaluate::<true>(ctx)
+    }
+
+    /// [`Self::importance`], or where `POINTS` [`Self::importance_of_points`].
+    #[target_feature(enable = "avx,avx2")]
+    #[inline]
+    fn evaluate<const POINTS: bool>(&self, ctx: &ShadingCtx) -> [f32; LANES] {
         let splat = _mm256_set1_ps;
         let (zero, one) = (_mm256_setzero_ps(), splat(1.0));
         let select = |mask: __m256, yes: __m256, no: __m256| _mm256_blendv_ps(no, yes, mask);
@@ -193,21 +241,39 @@ impl LoadedLanes {
         let cos_w = dot(self.w, wi);
         let cos_w = select(self.two_sided, _mm256_andnot_ps(splat(-0.0), cos_w), cos_w);
         let sin_w = safe_sqrt(one_minus_sq(cos_w));
-        let inside = _mm256_cmp_ps::<_CMP_LE_OQ>(d2, _mm256_mul_ps(radius, radius));
-        let sin_b_out = _mm256_mul_ps(radius, inv_d);
-        let sin_b = select(inside, zero, sin_b_out);
-        let cos_b = select(inside, splat(-1.0), safe_sqrt(one_minus_sq(sin_b_out)));
         let (sin_o, cos_o) = (self.sin_theta_o, self.cos_theta_o);
         let cos_x = cos_sub(sin_w, cos_w, sin_o, cos_o);
-        let sin_x = sin_sub(sin_w, cos_w, sin_o, cos_o);
-        let cos_p = cos_sub(sin_x, cos_x, sin_b, cos_b);
+        // With a radius of 0, sin θ_b = 0·(1/d) = 0 and cos θ_b = √(1 − 0) = 1 but at the
+        // light (d² = 0, "inside"), where it is −1. The products with sin θ_b are then
+        // zeros, which leave a sum unchanged but for the sign of a zero, and a zero
+        // importance comes out +0 from the final `max` whatever its sign.
+        let (cos_p, cos_b, sin_b) = if POINTS {
+            let inside = _mm256_cmp_ps::<_CMP_LE_OQ>(d2, zero);
+            let cos_b = select(inside, splat(-1.0), one);
+            let v = _mm256_mul_ps(cos_x, cos_b);
+            let cos_p = select(_mm256_cmp_ps::<_CMP_GT_OQ>(cos_x, cos_b), one, v);
+            (cos_p, cos_b, zero)
+        } else {
+            let inside = _mm256_cmp_ps::<_CMP_LE_OQ>(d2, _mm256_mul_ps(radius, radius));
+            let sin_b_out = _mm256_mul_ps(radius, inv_d);
+            let sin_b = select(inside, zero, sin_b_out);
+            let cos_b = select(inside, splat(-1.0), safe_sqrt(one_minus_sq(sin_b_out)));
+            let sin_x = sin_sub(sin_w, cos_w, sin_o, cos_o);
+            (cos_sub(sin_x, cos_x, sin_b, cos_b), cos_b, sin_b)
+        };
         let refused = _mm256_cmp_ps::<_CMP_LT_OQ>(cos_p, self.cos_theta_e);
         let mut importance = _mm256_div_ps(_mm256_mul_ps(self.intensity, cos_p), d2c);
         if ctx.n != glam::Vec3::ZERO {
             let n = [splat(ctx.n.x), splat(ctx.n.y), splat(ctx.n.z)];
             let cos_i = _mm256_andnot_ps(splat(-0.0), dot(wi, n));
-            let sin_i = safe_sqrt(one_minus_sq(cos_i));
-            importance = _mm256_mul_ps(importance, cos_sub(sin_i, cos_i, sin_b, cos_b));
+            let receiver = if POINTS {
+                let v = _mm256_mul_ps(cos_i, cos_b);
+                select(_mm256_cmp_ps::<_CMP_GT_OQ>(cos_i, cos_b), one, v)
+            } else {
+                let sin_i = safe_sqrt(one_minus_sq(cos_i));
+                cos_sub(sin_i, cos_i, sin_b, cos_b)
+            };
+            importance = _mm256_mul_ps(importance, receiver);
         }
         let importance = select(refused, zero, _mm256_max_ps(importance, zero));
         // Stored here, where the intrinsic inlines (outside AVX2 code it was a call).
@@ -235,13 +301,16 @@ mod tests {
             (state >> 40) as f32 / (1u64 << 24) as f32
         };
         let mut r = |lo: f32, hi: f32| lo + (hi - lo) * uniform();
-        let mut compared = 0;
+        let (mut compared, mut compared_points) = (0, 0);
         for round in 0..2000 {
             let n = 1 + round % LANES;
+            // Every third set of bounds is points (a radius of 0: point and spot lights).
+            let points = round % 3 == 0;
             let bounds: Vec<ImportanceBounds> = (0..n)
                 .map(|_| {
                     let c = Vec3::new(r(-4.0, 4.0), r(-4.0, 4.0), r(-4.0, 4.0));
                     let e = Vec3::new(r(0.0, 1.5), r(0.0, 1.5), r(0.0, 1.5));
+                    let e = if points { Vec3::ZERO } else { e };
                     let w = Vec3::new(r(-1.0, 1.0), r(-1.0, 1.0), r(-1.0, 1.0));
                     let lb = LightBounds {
                         aabb: Aabb {
@@ -271,6 +340,15 @@ mod tests {
                 };
                 let got = lanes.importance(&ctx);
                 let fallback = lanes.importance_scalar(&ctx);
+                #[cfg(target_arch = "x86_64")]
+                if points && std::arch::is_x86_feature_detected!("avx2") {
+                    // SAFETY: the CPU has AVX2.
+                    let of_points = unsafe { lanes.importance_of_points_avx2(&ctx) };
+                    for i in 0..n {
+                        assert_eq!(of_points[i].to_bits(), got[i].to_bits(), "{round} {k} {i}");
+                    }
+                    compared_points += 1;
+                }
                 for (i, b) in bounds.iter().enumerate() {
                     let want = b.importance(&ctx);
                     assert_eq!(got[i].to_bits(), want.to_bits(), "{round} {k} {i}: {b:?}");
@@ -281,5 +359,9 @@ mod tests {
         }
         // Most pairs weigh something (a test of zeros alone would prove little).
         assert!(compared > 30_000, "{compared}");
+        #[cfg(target_arch = "x86_64")]
+        if std::arch::is_x86_feature_detected!("avx2") {
+            assert!(compared_points > 5000, "{compared_points}");
+        }
     }
 }

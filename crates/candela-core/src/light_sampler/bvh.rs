@@ -257,7 +257,7 @@ impl LightBvh {
     /// The importances of the infinite lights at `ctx` (the first `infinite.len()`
     /// entries) and their sum, or `None` where they are to be picked uniformly (no
     /// measures, or nothing positive).
-    #[inline]
+    #[inline(always)]
     fn infinite_weights(&self, ctx: &ShadingCtx) -> Option<([f32; INFINITE_MAX], f32)> {
         if self.infinite_importance.is_empty() {
             return None;
