@@ -136,10 +136,17 @@ impl Material {
                     a.bsdf_at(si)
                 }
             }
-            // A Lambertian lobe looks the same in every frame around ns, so it skips
-            // orthogonalizing the tangent (a square root and a division per hit).
-            Material::Diffuse { .. } => Bsdf::new(si.ns, si.ng, self.lobe(si.uv, si.color)),
-            _ => Bsdf::with_tangent(si.ns, si.ng, si.dpdu, self.lobe(si.uv, si.color)),
+            // An isotropic lobe (Lambertian, or of one roughness on both axes) looks the
+            // same in every frame around ns, so it skips orthogonalizing the tangent (a
+            // square root and a division per hit).
+            _ => {
+                let lobe = self.lobe(si.uv, si.color);
+                if lobe.is_isotropic() {
+                    Bsdf::new(si.ns, si.ng, lobe)
+                } else {
+                    Bsdf::with_tangent(si.ns, si.ng, si.dpdu, lobe)
+                }
+            }
         }
     }
 
@@ -192,14 +199,19 @@ impl Material {
         }
     }
 
-    /// Whether [`Self::bsdf_at`] reads the hit's ∂p/∂u or bitangent sign: every lobe's
-    /// frame but a Lambertian one's, and normal maps.
+    /// Whether [`Self::bsdf_at`] reads the hit's ∂p/∂u or bitangent sign: the frame of an
+    /// anisotropic lobe (see [`Lobe::is_isotropic`]), and normal maps.
     pub fn reads_dpdu(&self) -> bool {
         match self {
             Material::Diffuse { .. } => false,
+            Material::Fixed(lobe) => !lobe.is_isotropic(),
+            Material::Plastic { coat, .. } => !Lobe::Plastic(*coat).is_isotropic(),
+            Material::Dielectric { lobe, .. } => !Lobe::Dielectric(*lobe).is_isotropic(),
+            // One roughness on both axes (`MetalRough::new`).
+            Material::MetalRough { .. } => false,
+            Material::NormalMap { .. } => true,
             Material::OneSided(inner) => inner.reads_dpdu(),
             Material::Mix { a, b, .. } => a.reads_dpdu() || b.reads_dpdu(),
-            _ => true,
         }
     }
 
@@ -427,7 +439,13 @@ mod mix_tests {
         let reads = |m: &Material| (m.reads_uv(), m.reads_dpdu());
         assert_eq!(reads(&diffuse(0.5)), (false, false));
         assert_eq!(reads(&textured), (true, false));
-        assert_eq!(reads(&metal), (false, true));
+        // Isotropic GGX: its frame's tangent is arbitrary.
+        assert_eq!(reads(&metal), (false, false));
+        let anisotropic = Material::Fixed(Lobe::Conductor(crate::bsdf::Conductor {
+            distrib: crate::bsdf::Microfacet::beckmann(0.1, 0.3),
+            fresnel: crate::bsdf::ConductorFresnel::Schlick { f0: Vec3::ONE },
+        }));
+        assert_eq!(reads(&anisotropic), (false, true));
         let normal_mapped = Material::NormalMap {
             map: Texture::Constant(Vec3::new(0.5, 0.5, 1.0)),
             inner: Box::new(diffuse(0.5)),
@@ -445,7 +463,7 @@ mod mix_tests {
             (true, false)
         );
         assert_eq!(
-            reads(&Material::mix(constant_weight, diffuse(0.2), metal)),
+            reads(&Material::mix(constant_weight, diffuse(0.2), anisotropic)),
             (false, true)
         );
     }

@@ -157,6 +157,24 @@ impl Lobe {
         !matches!(self, Lobe::Diffuse(_) | Lobe::Conductor(_))
     }
 
+    /// Whether the lobe looks the same in every frame about its normal (no anisotropic
+    /// roughness): then its shading frame's tangent is arbitrary, and the material builds
+    /// it with [`Bsdf::new`] (no tangent to orthogonalize, no ∂p/∂u to read) rather than
+    /// [`Bsdf::with_tangent`].
+    pub fn is_isotropic(&self) -> bool {
+        let round = |m: &Microfacet| {
+            let (ax, ay) = m.alpha();
+            ax == ay
+        };
+        match self {
+            Lobe::Diffuse(_) | Lobe::ThinDielectric(_) => true,
+            Lobe::Conductor(l) => round(&l.distrib),
+            Lobe::Dielectric(l) => round(&l.distrib),
+            Lobe::Plastic(l) => round(&l.distrib),
+            Lobe::MetalRough(l) => l.distrib.alpha_x == l.distrib.alpha_y,
+        }
+    }
+
     #[inline]
     fn is_reflective(&self) -> bool {
         !matches!(self, Lobe::Dielectric(_) | Lobe::ThinDielectric(_))
