@@ -152,7 +152,8 @@ impl LimbSums {
         let limbs = &mut self.limbs[start..start + len];
         let counts = &mut self.counts[start..start + len];
         for ((limbs, n), w) in limbs.iter_mut().zip(counts).zip(&w) {
-            add_share(limbs, rgb1, _mm256_set1_pd(*w));
+            // SAFETY: this function's features.
+            unsafe { add_share(limbs, rgb1, _mm256_set1_pd(*w)) };
             *n += 1;
         }
     }
@@ -165,10 +166,11 @@ impl LimbSums {
     ///
     /// # Safety
     /// The CPU must have AVX2 and FMA.
+    /// Inlined, so that its intrinsics inline into a caller compiled for them (the v3
+    /// render loop).
     #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx,avx2,fma")]
-    #[inline]
-    pub fn add_4x4_avx2(
+    #[inline(always)]
+    pub unsafe fn add_4x4_avx2(
         &mut self,
         (start, stride): (usize, usize),
         rgb1: std::arch::x86_64::__m256d,
@@ -195,8 +197,7 @@ impl LimbSums {
     /// # Safety
     /// The CPU must have AVX2 and FMA, and pixels `start` … `start + 3` must exist.
     #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx,avx2,fma")]
-    #[inline]
+    #[inline(always)]
     unsafe fn add_row4(
         &mut self,
         start: usize,
@@ -233,10 +234,12 @@ impl LimbSums {
 
 /// One share, `rgb1` × `weight` (the weight in every lane), into `limbs`: the scalar
 /// path's operations lane by lane.
+///
+/// # Safety
+/// The CPU must have AVX2 and FMA.
 #[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx,avx2,fma")]
-#[inline]
-fn add_share(
+#[inline(always)]
+unsafe fn add_share(
     limbs: &mut Limbs,
     rgb1: std::arch::x86_64::__m256d,
     weight: std::arch::x86_64::__m256d,
@@ -262,11 +265,11 @@ fn add_share(
 /// 2⁴⁰), for [`LimbSums::add_row_avx2`].
 ///
 /// # Safety
-/// The CPU must have AVX2.
+/// The CPU must have AVX2. Inlined, so that its intrinsics inline into a caller compiled
+/// for them.
 #[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx,avx2")]
-#[inline]
-pub fn rgb1(radiance: Vec3) -> std::arch::x86_64::__m256d {
+#[inline(always)]
+pub unsafe fn rgb1(radiance: Vec3) -> std::arch::x86_64::__m256d {
     use std::arch::x86_64::*;
     _mm256_mul_pd(
         _mm256_cvtps_pd(_mm_set_ps(1.0, radiance.z, radiance.y, radiance.x)),

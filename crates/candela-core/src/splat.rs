@@ -195,11 +195,11 @@ impl SampleSink for SplatSink<'_> {
     const SPLATS: bool = true;
 
     /// Inlined into each copy of the render loop: in the v3 copy its floors and ceilings
-    /// are single instructions.
+    /// are single instructions. The v3 shares go through [`add_in_lanes`], out of line
+    /// (the lanes integrator's call).
     #[inline(always)]
     fn add(&mut self, p: UVec2, film_pos: Vec2, l: Vec3) {
-        let own = ((p.y - self.own_y0) * self.width + p.x) as usize;
-        if !self.own[own].count(l) {
+        if !self.count(p, l) {
             return;
         }
         #[cfg(target_arch = "x86_64")]
@@ -212,13 +212,51 @@ impl SampleSink for SplatSink<'_> {
                 }
             }
         }
-        let xs = footprint(film_pos.x, self.radius, self.width);
-        let ys = footprint(film_pos.y, self.radius, self.height);
-        self.add_shares(xs, ys, film_pos, l);
+        self.add_footprint(film_pos, l);
+    }
+
+    /// [`Self::add`]; in the v3 copy of the path integrator's render loop the AVX2 shares
+    /// ([`add_in_lanes_inlined`]) are inlined into it, without a call's entry and exit.
+    #[inline(always)]
+    fn add_in<const V3: bool>(&mut self, p: UVec2, film_pos: Vec2, l: Vec3) {
+        #[cfg(target_arch = "x86_64")]
+        if V3 {
+            if !self.count(p, l) {
+                return;
+            }
+            let film = (self.width, self.height, self.radius);
+            if let Shares::Limbs(sums) = &mut self.block.shares {
+                // SAFETY: `V3` is the v3 copy, which runs only where the CPU has it.
+                let added = unsafe {
+                    add_in_lanes_inlined(sums, self.filter, film, self.block.y0, film_pos, l)
+                };
+                if added {
+                    return;
+                }
+            }
+            self.add_footprint(film_pos, l);
+            return;
+        }
+        self.add(p, film_pos, l);
     }
 }
 
 impl SplatSink<'_> {
+    /// Counts a sample of pixel `p` in the band's own pixels; whether it is accepted.
+    #[inline(always)]
+    fn count(&mut self, p: UVec2, l: Vec3) -> bool {
+        let own = ((p.y - self.own_y0) * self.width + p.x) as usize;
+        self.own[own].count(l)
+    }
+
+    /// An accepted sample's shares over its footprint, one by one.
+    #[inline(always)]
+    fn add_footprint(&mut self, film_pos: Vec2, l: Vec3) {
+        let xs = footprint(film_pos.x, self.radius, self.width);
+        let ys = footprint(film_pos.y, self.radius, self.height);
+        self.add_shares(xs, ys, film_pos, l);
+    }
+
     /// [`SampleSink::add`]'s shares one by one, each weight computed as the AVX2 rows
     /// compute it (a row's x weights once where they fit a cache).
     fn add_shares(&mut self, xs: Range<u32>, ys: Range<u32>, film_pos: Vec2, l: Vec3) {
@@ -274,6 +312,25 @@ impl SplatSink<'_> {
 #[target_feature(enable = "avx,avx2,fma")]
 #[inline]
 fn add_in_lanes(
+    sums: &mut LimbSums,
+    filter: &PixelFilter,
+    film: (u32, u32, f32),
+    y0: u32,
+    film_pos: Vec2,
+    l: Vec3,
+) -> bool {
+    // SAFETY: this function's features.
+    unsafe { add_in_lanes_inlined(sums, filter, film, y0, film_pos, l) }
+}
+
+/// [`add_in_lanes`]' body, inlined into its caller: a function compiled for AVX2 and FMA
+/// (the v3 copy of the render loop, or [`add_in_lanes`]), whose intrinsics it inlines.
+///
+/// # Safety
+/// The CPU must have AVX2 and FMA.
+#[cfg(target_arch = "x86_64")]
+#[inline(always)]
+unsafe fn add_in_lanes_inlined(
     sums: &mut LimbSums,
     filter: &PixelFilter,
     (width, height, r): (u32, u32, f32),
@@ -335,11 +392,11 @@ fn add_in_lanes(
 /// footprints and the register (first x, first y, end x, end y).
 ///
 /// # Safety
-/// The CPU must have AVX2 and FMA.
+/// The CPU must have AVX2 and FMA. Inlined, so that its intrinsics inline into a caller
+/// compiled for them.
 #[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx,avx2,fma")]
-#[inline]
-fn footprints_in_lanes(
+#[inline(always)]
+unsafe fn footprints_in_lanes(
     film_pos: Vec2,
     r: f32,
     (width, height): (u32, u32),

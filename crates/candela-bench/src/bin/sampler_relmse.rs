@@ -320,7 +320,8 @@ impl Sampler for AnySampler {
             };
         }
         match self {
-            AnySampler::Independent(s) => Deferred::Value(s.defer_1d()),
+            // The number its deferral would resolve to, drawn now.
+            AnySampler::Independent(s) => Deferred::Value(s.get_1d()),
             AnySampler::Sobol(s) => Deferred::Dimension(s.defer_1d()),
             AnySampler::SobolCmj(s) => Deferred::Dimension(s.defer_1d()),
             AnySampler::ZSobol(s) => Deferred::Dimension(s.defer_1d()),

@@ -64,14 +64,17 @@ impl Aperture {
 /// together with the other (Heitz 2019's square-to-triangle map).
 #[derive(Clone, Debug)]
 pub struct PolygonAperture {
+    /// The corners, counter-clockwise, and corner 0 again at the end (a triangle's second
+    /// corner without a modulo).
     corners: Vec<Vec2>,
 }
 
 impl PolygonAperture {
     /// `blades ≥ 3` corners on the unit circle, corner 0 at angle π/2 + `rotation`.
     pub fn new(blades: u32, rotation: f32) -> PolygonAperture {
-        let corners = (0..blades)
+        let corners = (0..=blades)
             .map(|k| {
+                let k = k % blades;
                 let phi = FRAC_PI_2 + rotation + TAU * k as f32 / blades as f32;
                 Vec2::new(phi.cos(), phi.sin())
             })
@@ -81,30 +84,29 @@ impl PolygonAperture {
 
     /// The corners, counter-clockwise.
     pub fn corners(&self) -> &[Vec2] {
-        &self.corners
+        &self.corners[..self.corners.len() - 1]
     }
 
     /// Area: n/2 · sin(2π/n) for a polygon inscribed in the unit circle.
     pub fn area(&self) -> f32 {
-        let n = self.corners.len() as f32;
+        let n = self.corners().len() as f32;
         0.5 * n * (TAU / n).sin()
     }
 
     pub fn sample(&self, u: Vec2) -> Vec2 {
-        let n = self.corners.len();
+        let n = self.corners().len();
         let scaled = u.x * n as f32;
         let i = (scaled as usize).min(n - 1);
         let ux = (scaled - i as f32).clamp(0.0, crate::sampling::ONE_MINUS_EPSILON);
         let b = sample_uniform_triangle(Vec2::new(ux, u.y));
         // Barycentrics (b0, b1, b2) over (centre, corner i, corner i+1).
-        b.y * self.corners[i] + b.z * self.corners[(i + 1) % n]
+        b.y * self.corners[i] + b.z * self.corners[i + 1]
     }
 
     /// Whether `p` lies inside (or on) the polygon.
     pub fn contains(&self, p: Vec2) -> bool {
-        let n = self.corners.len();
-        (0..n).all(|i| {
-            let (a, b) = (self.corners[i], self.corners[(i + 1) % n]);
+        self.corners.windows(2).all(|e| {
+            let (a, b) = (e[0], e[1]);
             (b - a).perp_dot(p - a) >= -1e-6
         })
     }

@@ -8,7 +8,7 @@ mod thin_lens;
 pub use aperture::{Aperture, ImageAperture, PolygonAperture};
 pub use thin_lens::ThinLens;
 
-use glam::{Vec2, Vec3};
+use glam::{Vec2, Vec3, Vec3A};
 
 use crate::desc::CameraDesc;
 use crate::geometry::Ray;
@@ -38,10 +38,11 @@ impl CameraDesc {
 #[derive(Clone, Debug)]
 pub struct Camera {
     pub position: Vec3,
-    /// Camera-to-world rotation: columns are the camera's right, up and backward axes.
-    right: Vec3,
-    up: Vec3,
-    back: Vec3,
+    /// Camera-to-world rotation: columns are the camera's right, up and backward axes
+    /// (each in one SSE register: the rotation is three multiplies and two adds).
+    right: Vec3A,
+    up: Vec3A,
+    back: Vec3A,
     /// tan(fov_y / 2)
     tan_half_fov: f32,
     resolution: Vec2,
@@ -65,9 +66,9 @@ impl Camera {
             .filter(|l| l.aperture_radius > 0.0);
         Camera {
             position: desc.position,
-            right,
-            up,
-            back,
+            right: right.into(),
+            up: up.into(),
+            back: back.into(),
             tan_half_fov: (desc.vertical_fov_deg().to_radians() * 0.5).tan(),
             resolution: Vec2::new(width as f32, height as f32),
             lens,
@@ -105,8 +106,10 @@ impl Camera {
         )
     }
 
+    /// A camera-frame vector in the world frame: lane by lane the operations of
+    /// `right·x + up·y + back·z` in `Vec3`, so the same bits.
     #[inline]
-    fn to_world(&self, v: Vec3) -> Vec3 {
+    fn to_world(&self, v: Vec3) -> Vec3A {
         self.right * v.x + self.up * v.y + self.back * v.z
     }
 
@@ -117,8 +120,8 @@ impl Camera {
         if let Some(h) = self.ortho_half_height {
             return self.orthographic_ray(h, film);
         }
-        let d = self.to_world(self.pinhole_direction(film)).normalize();
-        Ray::new(self.position, d)
+        let d = normalize(self.to_world(self.pinhole_direction(film)));
+        Ray::new(self.position, d.into())
     }
 
     /// The orthographic ray through film position `film`: from the camera's plane, along
@@ -127,7 +130,7 @@ impl Camera {
     fn orthographic_ray(&self, half_height: f32, film: Vec2) -> Ray {
         let (s, aspect) = self.screen(film);
         let o = Vec3::new(s.x * half_height * aspect, s.y * half_height, 0.0);
-        Ray::new(self.position + self.to_world(o), -self.back)
+        Ray::new(self.position + Vec3::from(self.to_world(o)), self.forward())
     }
 
     /// The ray through film position `film` from the lens point of the uniform sample
@@ -146,8 +149,8 @@ impl Camera {
     fn thin_lens_ray(&self, lens: &ThinLens, film: Vec2, lens_u: Vec2) -> Ray {
         let (o, d) = lens.ray(self.pinhole_direction(film), lens_u);
         Ray::new(
-            self.position + self.to_world(o),
-            self.to_world(d).normalize(),
+            self.position + Vec3::from(self.to_world(o)),
+            normalize(self.to_world(d)).into(),
         )
     }
 
@@ -156,7 +159,8 @@ impl Camera {
     /// [`Self::generate_lens_ray`], for tests and for tracing from lights.
     pub fn project(&self, p: Vec3, lens_u: Vec2) -> Option<Vec2> {
         let v = p - self.position;
-        let pc = Vec3::new(v.dot(self.right), v.dot(self.up), v.dot(self.back));
+        let axis = |a: Vec3A| v.dot(a.into());
+        let pc = Vec3::new(axis(self.right), axis(self.up), axis(self.back));
         // The point on the plane at distance 1 (perspective) or on the camera's plane
         // (orthographic), and that plane's half height.
         let (x, y, half_height) = if let Some(h) = self.ortho_half_height {
@@ -183,8 +187,15 @@ impl Camera {
 
     /// The camera's viewing direction in world space.
     pub fn forward(&self) -> Vec3 {
-        -self.back
+        -Vec3::from(self.back)
     }
+}
+
+/// `Vec3::normalize` in one SSE register: v · (1 / √(v·v)), the same operations in the
+/// same order (x² + y², then + z²), so the same bits.
+#[inline]
+pub(crate) fn normalize(v: Vec3A) -> Vec3A {
+    v * (1.0 / v.dot(v).sqrt())
 }
 
 #[cfg(test)]

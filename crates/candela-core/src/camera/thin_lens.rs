@@ -8,7 +8,7 @@
 //! the image height, is A·|z − F| / (z·F·tan(fov/2)) for aperture radius A — the same as
 //! the photographic c = 2A·|z − F|/z · f/(F − f) over the sensor height.
 
-use glam::{Vec2, Vec3};
+use glam::{Vec2, Vec3, Vec3A};
 
 use super::aperture::Aperture;
 use crate::desc::{ApertureSizeDesc, CameraDesc, FocusDesc, LensDesc};
@@ -57,9 +57,9 @@ impl ThinLens {
     /// The ray, in the camera frame, from the lens point of `u` through the point where
     /// the pinhole direction `d_pinhole` (with z = −1) meets the plane of focus.
     pub fn ray(&self, d_pinhole: Vec3, u: Vec2) -> (Vec3, Vec3) {
-        let focus = d_pinhole * self.focus_distance;
+        let focus = Vec3A::from(d_pinhole) * self.focus_distance;
         let lens = self.sample_point(u).extend(0.0);
-        (lens, (focus - lens).normalize())
+        (lens, super::normalize(focus - Vec3A::from(lens)).into())
     }
 
     /// Where the line from lens point `lens` through `p` (camera frame, in front of the

@@ -28,6 +28,13 @@ pub(crate) trait SampleSink {
     const SPLATS: bool;
     /// Takes the radiance `l` of a sample of pixel `p` at film position `film_pos`.
     fn add(&mut self, p: UVec2, film_pos: Vec2, l: Vec3);
+    /// [`Self::add`] from the copy of the render loop that `V3` names (true: the
+    /// x86-64-v3 copy, whose CPU has AVX2 and FMA): a sink may inline its AVX2 code there,
+    /// which it cannot from [`Self::add`], compiled for every copy. The same result.
+    #[inline(always)]
+    fn add_in<const V3: bool>(&mut self, p: UVec2, film_pos: Vec2, l: Vec3) {
+        self.add(p, film_pos, l);
+    }
 }
 
 /// Starts pixel sample `index` of pixel `p` and makes its camera ray: the film position
@@ -61,16 +68,17 @@ pub(crate) fn camera_ray<S: Sampler>(
 /// Takes a band's samples; inlined into each copy of the render loop, so that it and
 /// its callees (the path loop and its next event estimation included) are compiled for
 /// each. Where the scene packs camera rays ([`Scene::packs_camera_rays`]) and has no
-/// media, the camera rays go eight at a time ([`render_pixels_packed`]).
+/// media, the camera rays go eight at a time ([`render_pixels_packed`]). `V3`: whether
+/// this is the x86-64-v3 copy (see [`SampleSink::add_in`]).
 #[inline(always)]
-pub(super) fn render_pixels<S: Sampler, K: SampleSink>(
+pub(super) fn render_pixels<S: Sampler, K: SampleSink, const V3: bool>(
     scene: &Scene,
     sampler: &mut S,
     band: Band,
     sink: &mut K,
 ) -> RenderStats {
     if scene.media.is_none() && scene.packs_camera_rays() {
-        return render_pixels_packed(scene, sampler, band, sink);
+        return render_pixels_packed::<S, K, V3>(scene, sampler, band, sink);
     }
     let Band { rows, width, pass } = band;
     let mut stats = RenderStats::default();
@@ -83,7 +91,7 @@ pub(super) fn render_pixels<S: Sampler, K: SampleSink>(
                 let (film_pos, ray) = camera_ray(scene, sampler, p, index, K::SPLATS);
                 let l = li(scene, ray, sampler, &mut stats.rays);
                 stats.paths += 1;
-                sink.add(p, film_pos, l);
+                sink.add_in::<V3>(p, film_pos, l);
             }
         }
     }
@@ -98,7 +106,7 @@ pub(super) fn render_pixels<S: Sampler, K: SampleSink>(
 /// draws the same dimensions in the same order as one sampler taking the samples one
 /// after the other: the image is the same, bit for bit.
 #[inline(always)]
-fn render_pixels_packed<S: Sampler, K: SampleSink>(
+fn render_pixels_packed<S: Sampler, K: SampleSink, const V3: bool>(
     scene: &Scene,
     sampler: &mut S,
     band: Band,
@@ -123,13 +131,13 @@ fn render_pixels_packed<S: Sampler, K: SampleSink>(
                 packet.rays[i] = ray;
                 packet.len += 1;
                 if packet.len == PACKET {
-                    packet.finish(scene, sink, &mut stats);
+                    packet.finish::<K, V3>(scene, sink, &mut stats);
                 }
             }
         }
     }
     if packet.len > 0 {
-        packet.finish(scene, sink, &mut stats);
+        packet.finish::<K, V3>(scene, sink, &mut stats);
     }
     stats
 }
@@ -150,7 +158,12 @@ impl<S: Sampler> CameraPacket<S> {
     /// Traces the rays, follows each path from its hit and hands the radiance to
     /// `sink`, in the order the samples came; the packet is then empty.
     #[inline(always)]
-    fn finish<K: SampleSink>(&mut self, scene: &Scene, sink: &mut K, stats: &mut RenderStats) {
+    fn finish<K: SampleSink, const V3: bool>(
+        &mut self,
+        scene: &Scene,
+        sink: &mut K,
+        stats: &mut RenderStats,
+    ) {
         let hits = scene.intersect_coherent8(&self.rays, (1u32 << self.len) - 1);
         let samples = (self.samplers.iter_mut().zip(hits))
             .zip(self.film.iter().zip(&self.rays))
@@ -158,7 +171,7 @@ impl<S: Sampler> CameraPacket<S> {
         for ((sampler, hit), (&(p, film_pos), &ray)) in samples {
             let l = li_from_hit(scene, ray, hit, sampler, &mut stats.rays);
             stats.paths += 1;
-            sink.add(p, film_pos, l);
+            sink.add_in::<V3>(p, film_pos, l);
         }
         self.len = 0;
     }

@@ -34,7 +34,7 @@ v3_fn! {
         band: Band,
         sink: &mut K,
     ) -> RenderStats {
-        render_pixels(scene, sampler, band, sink)
+        render_pixels::<S, K, true>(scene, sampler, band, sink)
     }
 }
 
@@ -68,7 +68,7 @@ pub(crate) fn render_band<S: Sampler, K: SampleSink>(
         (Isa::V3, false) => unsafe { render_pixels_v3(scene, sampler, band, sink) },
         #[cfg(target_arch = "x86_64")]
         (Isa::V3, true) => unsafe { render_lanes_v3(scene, sampler, band, sink) },
-        (_, false) => render_pixels(scene, sampler, band, sink),
+        (_, false) => render_pixels::<S, K, false>(scene, sampler, band, sink),
         (_, true) => render_lanes::<S, K, false>(scene, sampler, band, sink),
     }
 }

@@ -130,24 +130,26 @@ impl Sampler for IndependentSampler {
         self.rng.next_u32();
     }
 
-    /// A sequential stream cannot compute a request out of order: the number is drawn now.
-    type Deferred1d = f32;
+    /// The generator's state before the deferred step: the stream steps past the request
+    /// now (one multiply-add) and only a request that is read pays for the output
+    /// permutation and the conversion.
+    type Deferred1d = u64;
 
-    fn defer_1d(&mut self) -> f32 {
-        self.get_1d()
+    fn defer_1d(&mut self) -> u64 {
+        self.rng.step()
     }
 
-    fn resolve_1d(&self, u: f32) -> f32 {
-        u
+    fn resolve_1d(&self, old: u64) -> f32 {
+        Pcg32::uniform_of(Pcg32::output(old))
     }
 
     /// PCG32 for the eight streams at once in AVX2 (`pcg_lanes`); none without AVX2.
-    fn draw_bounce_lanes(streams: &mut [Self; LANES], avx2: bool) -> Option<BounceDraws<f32>> {
+    fn draw_bounce_lanes(streams: &mut [Self; LANES], avx2: bool) -> Option<BounceDraws<u64>> {
         #[cfg(target_arch = "x86_64")]
         if avx2 {
             // SAFETY: `avx2` says the CPU has AVX2.
-            let [light, px, py, lobe, dx, dy, roulette] =
-                unsafe { pcg_lanes::uniform_lanes::<7>(streams) };
+            let ([light, px, py, _, dx, dy, roulette], lobe) =
+                unsafe { pcg_lanes::uniform_lanes::<7>(streams, 3) };
             return Some(BounceDraws {
                 light,
                 point: [px, py],
@@ -184,8 +186,21 @@ impl Pcg32 {
     }
 
     pub fn next_u32(&mut self) -> u32 {
+        Self::output(self.step())
+    }
+
+    /// Advances the state; returns the state before, whose [`Self::output`] is this
+    /// step's number.
+    #[inline]
+    pub fn step(&mut self) -> u64 {
         let old = self.state;
         self.state = old.wrapping_mul(Self::MULT).wrapping_add(self.inc);
+        old
+    }
+
+    /// The output permutation (xorshift, random rotation) of the state before a step.
+    #[inline]
+    pub fn output(old: u64) -> u32 {
         let xorshifted = (((old >> 18) ^ old) >> 27) as u32;
         let rot = (old >> 59) as u32;
         xorshifted.rotate_right(rot)
@@ -193,7 +208,13 @@ impl Pcg32 {
 
     /// A uniform float in [0, 1), with 24 bits of randomness.
     pub fn uniform_f32(&mut self) -> f32 {
-        (self.next_u32() >> 8) as f32 * (1.0 / (1u32 << 24) as f32)
+        Self::uniform_of(self.next_u32())
+    }
+
+    /// [`Self::uniform_f32`] of an output.
+    #[inline]
+    pub fn uniform_of(word: u32) -> f32 {
+        (word >> 8) as f32 * (1.0 / (1u32 << 24) as f32)
     }
 }
 

@@ -11,20 +11,28 @@ use super::{IndependentSampler, Pcg32, LANES};
 
 /// The next `N` numbers of each of eight streams: `out[k][i]` is the `k`-th of stream `i`,
 /// what its `uniform_f32` gives on the `k`-th call from here; the streams move on by `N`.
+/// Besides, each stream's state before its step `keep` (a deferred request's, see
+/// [`super::Pcg32::step`]).
 ///
 /// # Safety
 /// The CPU must have AVX2.
 #[target_feature(enable = "avx2")]
 pub(super) unsafe fn uniform_lanes<const N: usize>(
     streams: &mut [IndependentSampler; LANES],
-) -> [[f32; LANES]; N] {
+    keep: usize,
+) -> ([[f32; LANES]; N], [u64; LANES]) {
     let mut state = [
         gather(streams, 0, |r| r.state),
         gather(streams, 4, |r| r.state),
     ];
     let inc = [gather(streams, 0, |r| r.inc), gather(streams, 4, |r| r.inc)];
     let mut out = [[0.0; LANES]; N];
-    for numbers in &mut out {
+    let mut kept = [0u64; LANES];
+    for (k, numbers) in out.iter_mut().enumerate() {
+        if k == keep {
+            _mm256_storeu_si256(kept.as_mut_ptr().cast(), state[0]);
+            _mm256_storeu_si256(kept[4..].as_mut_ptr().cast(), state[1]);
+        }
         let words = [step(&mut state[0], inc[0]), step(&mut state[1], inc[1])];
         *numbers = to_uniform(words);
     }
@@ -35,7 +43,7 @@ pub(super) unsafe fn uniform_lanes<const N: usize>(
             streams[4 * h + i].rng.state = s;
         }
     }
-    out
+    (out, kept)
 }
 
 /// One field of streams `first..first + 4`, one stream a 64-bit lane.
@@ -117,9 +125,12 @@ mod tests {
         let mut scalar = lanes.clone();
         for _ in 0..500 {
             // SAFETY: AVX2 checked above.
-            let got = unsafe { uniform_lanes::<7>(&mut lanes) };
+            let (got, kept) = unsafe { uniform_lanes::<7>(&mut lanes, 3) };
             for (k, numbers) in got.iter().enumerate() {
                 for (i, stream) in scalar.iter_mut().enumerate() {
+                    if k == 3 {
+                        assert_eq!(stream.rng.state, kept[i], "kept state, stream {i}");
+                    }
                     let want = stream.get_1d();
                     assert_eq!(
                         numbers[i].to_bits(),
