@@ -199,49 +199,67 @@ impl SampleSink for SplatSink<'_> {
     /// (the lanes integrator's call).
     #[inline(always)]
     fn add(&mut self, p: UVec2, film_pos: Vec2, l: Vec3) {
-        if !self.count(p, l) {
-            return;
-        }
         #[cfg(target_arch = "x86_64")]
-        if matches!(self.isa, Isa::V3) {
-            let film = (self.width, self.height, self.radius);
-            if let Shares::Limbs(sums) = &mut self.block.shares {
-                // SAFETY: the render loop runs its v3 copy only where the CPU has it.
-                if unsafe { add_in_lanes(sums, self.filter, film, self.block.y0, film_pos, l) } {
-                    return;
-                }
-            }
-        }
-        self.add_footprint(film_pos, l);
+        let lanes = matches!(self.isa, Isa::V3);
+        #[cfg(not(target_arch = "x86_64"))]
+        let lanes = false;
+        // SAFETY: the render loop runs its v3 copy only where the CPU has it.
+        unsafe { self.add_sharing::<false>(p, film_pos, l, lanes) }
     }
 
     /// [`Self::add`]; in the v3 copy of the path integrator's render loop the AVX2 shares
     /// ([`add_in_lanes_inlined`]) are inlined into it, without a call's entry and exit.
     #[inline(always)]
     fn add_in<const V3: bool>(&mut self, p: UVec2, film_pos: Vec2, l: Vec3) {
-        #[cfg(target_arch = "x86_64")]
         if V3 {
-            if !self.count(p, l) {
-                return;
-            }
-            let film = (self.width, self.height, self.radius);
-            if let Shares::Limbs(sums) = &mut self.block.shares {
-                // SAFETY: `V3` is the v3 copy, which runs only where the CPU has it.
-                let added = unsafe {
-                    add_in_lanes_inlined(sums, self.filter, film, self.block.y0, film_pos, l)
-                };
-                if added {
-                    return;
-                }
-            }
-            self.add_footprint(film_pos, l);
-            return;
+            // SAFETY: `V3` is the v3 copy, which runs only where the CPU has it.
+            return unsafe { self.add_sharing::<true>(p, film_pos, l, true) };
         }
         self.add(p, film_pos, l);
     }
 }
 
 impl SplatSink<'_> {
+    /// [`SampleSink::add`]'s body: the sample counted, then its shares, in AVX2 where
+    /// `lanes` ([`add_in_lanes`], or with `INLINED` its body [`add_in_lanes_inlined`]
+    /// inlined into the caller), one by one otherwise and where the lanes decline it.
+    ///
+    /// # Safety
+    /// Where `lanes`, the CPU must have AVX2 and FMA.
+    #[inline(always)]
+    unsafe fn add_sharing<const INLINED: bool>(
+        &mut self,
+        p: UVec2,
+        film_pos: Vec2,
+        l: Vec3,
+        lanes: bool,
+    ) {
+        if !self.count(p, l) {
+            return;
+        }
+        #[cfg(target_arch = "x86_64")]
+        if lanes {
+            let film = (self.width, self.height, self.radius);
+            if let Shares::Limbs(sums) = &mut self.block.shares {
+                let (filter, y0) = (self.filter, self.block.y0);
+                // SAFETY: the caller's promise for `lanes`.
+                let added = unsafe {
+                    if INLINED {
+                        add_in_lanes_inlined(sums, filter, film, y0, film_pos, l)
+                    } else {
+                        add_in_lanes(sums, filter, film, y0, film_pos, l)
+                    }
+                };
+                if added {
+                    return;
+                }
+            }
+        }
+        #[cfg(not(target_arch = "x86_64"))]
+        let _ = lanes;
+        self.add_footprint(film_pos, l);
+    }
+
     /// Counts a sample of pixel `p` in the band's own pixels; whether it is accepted.
     #[inline(always)]
     fn count(&mut self, p: UVec2, l: Vec3) -> bool {
