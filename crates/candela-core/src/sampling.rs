@@ -7,7 +7,7 @@
 
 use std::f32::consts::{FRAC_1_PI, FRAC_PI_4, PI};
 
-use glam::{Vec2, Vec3};
+use glam::{Vec2, Vec3, Vec4};
 
 /// Shirley–Chiu concentric map from the square to the unit disk (area-preserving up to
 /// the factor π).
@@ -28,18 +28,37 @@ pub fn sample_concentric_disk(u: Vec2) -> Vec2 {
     }
 }
 
+/// The Taylor coefficients of sin a / a and cos a in a², after the leading 1: a²/3!,
+/// a⁴/5!, … and a²/2!, a⁴/4!, … with their signs.
+const SIN_TAYLOR: [f32; 4] = [-1.0 / 6.0, 1.0 / 120.0, -1.0 / 5040.0, 1.0 / 362_880.0];
+const COS_TAYLOR: [f32; 4] = [-0.5, 1.0 / 24.0, -1.0 / 720.0, 1.0 / 40_320.0];
+
 /// (sin a, cos a) for |a| ≤ π/4, by their Taylor polynomials to degree 9 and 8: the
 /// first omitted terms, a¹¹/11! and a¹⁰/10!, are below 1.8·10⁻⁹ and 2.5·10⁻⁸ there, under
 /// half an f32 ulp of the result.
 #[inline]
 pub fn sin_cos_quarter(a: f32) -> (f32, f32) {
     let a2 = a * a;
-    let s = a
-        * (1.0
-            + a2 * (-1.0 / 6.0
-                + a2 * (1.0 / 120.0 + a2 * (-1.0 / 5040.0 + a2 * (1.0 / 362_880.0)))));
-    let c = 1.0 + a2 * (-0.5 + a2 * (1.0 / 24.0 + a2 * (-1.0 / 720.0 + a2 * (1.0 / 40_320.0))));
+    let [s1, s2, s3, s4] = SIN_TAYLOR;
+    let [c1, c2, c3, c4] = COS_TAYLOR;
+    let s = a * (1.0 + a2 * (s1 + a2 * (s2 + a2 * (s3 + a2 * s4))));
+    let c = 1.0 + a2 * (c1 + a2 * (c2 + a2 * (c3 + a2 * c4)));
     (s, c)
+}
+
+/// 1.5·2²³: adding and subtracting it rounds an f32 of magnitude under 2²² to the nearest
+/// integer.
+const ROUND_TO_INTEGER: f32 = 12_582_912.0;
+
+/// (s, c) = (sin r, cos r) turned by `q` quarter turns: (sin, cos) of r + q·π/2.
+#[inline]
+fn quarter_turned(q: f32, s: f32, c: f32) -> (f32, f32) {
+    match (q as i32) & 3 {
+        0 => (s, c),
+        1 => (c, -s),
+        2 => (-s, -c),
+        _ => (-c, s),
+    }
 }
 
 /// (sin, cos) of t·π/2 for |t| ≤ 2²²: t split into the nearest integer q (by the
@@ -50,15 +69,28 @@ pub fn sin_cos_quarter(a: f32) -> (f32, f32) {
 /// rounding.
 #[inline]
 pub fn sin_cos_quarter_turns(t: f32) -> (f32, f32) {
-    const ROUND: f32 = 12_582_912.0;
-    let q = (t + ROUND) - ROUND;
+    let q = (t + ROUND_TO_INTEGER) - ROUND_TO_INTEGER;
     let (s, c) = sin_cos_quarter(std::f32::consts::FRAC_PI_2 * (t - q));
-    match (q as i32) & 3 {
-        0 => (s, c),
-        1 => (c, -s),
-        2 => (-s, -c),
-        _ => (-c, s),
-    }
+    quarter_turned(q, s, c)
+}
+
+/// [`sin_cos_quarter_turns`] of `t.x` and `t.y`, bit for bit, with the four polynomials
+/// (two sines, two cosines) evaluated together in SIMD lanes: the same operations in the
+/// same order in every lane (a cosine's final product with 1 is exact).
+#[inline]
+pub fn sin_cos_quarter_turns_pair(t: Vec2) -> [(f32, f32); 2] {
+    let t = Vec4::new(t.x, t.x, t.y, t.y);
+    let q = (t + ROUND_TO_INTEGER) - ROUND_TO_INTEGER;
+    let a = std::f32::consts::FRAC_PI_2 * (t - q);
+    let a2 = a * a;
+    // Lanes: sin and cos of the first angle, then of the second.
+    let coefficient =
+        |i: usize| Vec4::new(SIN_TAYLOR[i], COS_TAYLOR[i], SIN_TAYLOR[i], COS_TAYLOR[i]);
+    let mut p = coefficient(2) + a2 * coefficient(3);
+    p = coefficient(1) + a2 * p;
+    p = coefficient(0) + a2 * p;
+    p = Vec4::new(a.x, 1.0, a.z, 1.0) * (1.0 + a2 * p);
+    [quarter_turned(q.x, p.x, p.y), quarter_turned(q.z, p.z, p.w)]
 }
 
 /// Cosine-weighted direction on the hemisphere around +z (Malley's method).
@@ -413,6 +445,26 @@ mod tests {
         assert_eq!(sin_cos_quarter_turns(0.0), (0.0, 1.0));
         assert_eq!(sin_cos_quarter_turns(1.0), (1.0, -0.0));
         assert_eq!(sin_cos_quarter_turns(-2.0), (0.0, -1.0));
+    }
+
+    #[test]
+    fn sin_cos_quarter_turns_pair_gives_the_scalar_bits() {
+        // Two different angles a call, over [−2, 2] quarter turns (quadrant edges, zeros
+        // of either sign, half-way points included).
+        let mut ts = vec![0.0, -0.0, 0.5, -0.5, 1.0, -1.0, 1.5, 2.0, -2.0, 0.25];
+        ts.extend((0..=40_000).map(|i| i as f32 / 10_000.0 - 2.0));
+        for (i, &t0) in ts.iter().enumerate() {
+            let t1 = ts[(i * 7919 + 13) % ts.len()];
+            let pair = sin_cos_quarter_turns_pair(Vec2::new(t0, t1));
+            for (t, (s, c)) in [(t0, pair[0]), (t1, pair[1])] {
+                let (ws, wc) = sin_cos_quarter_turns(t);
+                assert_eq!(
+                    (s.to_bits(), c.to_bits()),
+                    (ws.to_bits(), wc.to_bits()),
+                    "t = {t}"
+                );
+            }
+        }
     }
 
     #[test]

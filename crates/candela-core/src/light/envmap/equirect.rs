@@ -6,8 +6,8 @@ use glam::{Vec2, Vec3, Vec4};
 
 use super::bilinear::{Bilinear2D, GridAxis};
 use super::{compensated, Image, MapSample};
-use crate::math::{atan2_poly, luminance};
-use crate::sampling::{sample_bilinear, sin_cos_quarter_turns};
+use crate::math::{atan2_poly_lanes, luminance};
+use crate::sampling::{sample_bilinear, sin_cos_quarter_turns, sin_cos_quarter_turns_pair};
 
 /// A panorama in the native mapping of [`super`]: y up, centre along −z.
 ///
@@ -40,13 +40,18 @@ pub fn direction_to_uv(d: Vec3) -> Vec2 {
 }
 
 /// [`direction_to_uv`] and sin θ = √(x² + z²), which it computes on the way (θ as
-/// atan2(sin θ, cos θ), both angles by [`atan2_poly`]: a third of libm's `atan2f` and
-/// `acosf`, as accurate).
+/// atan2(sin θ, cos θ); both angles by [`atan2_poly_lanes`], in two lanes of one pass:
+/// bit for bit [`crate::math::atan2_poly`], a third of libm's `atan2f` and `acosf`, as
+/// accurate).
 #[inline]
 fn direction_to_uv_sin(d: Vec3) -> (Vec2, f32) {
     let sin_theta = (d.x * d.x + d.z * d.z).sqrt();
-    let u = 0.5 * (1.0 + atan2_poly(d.x, -d.z) * FRAC_1_PI);
-    let v = atan2_poly(sin_theta, d.y) * FRAC_1_PI;
+    let angles = atan2_poly_lanes(
+        Vec4::new(d.x, sin_theta, 0.0, 0.0),
+        Vec4::new(-d.z, d.y, 1.0, 1.0),
+    );
+    let u = 0.5 * (1.0 + angles.x * FRAC_1_PI);
+    let v = angles.y * FRAC_1_PI;
     (Vec2::new(u, v), sin_theta)
 }
 
@@ -55,13 +60,12 @@ pub fn uv_to_direction(uv: Vec2) -> Vec3 {
     uv_to_direction_sin(uv).0
 }
 
-/// [`uv_to_direction`] and the sin θ it computes on the way. The angles, φ = π(2u − 1)
-/// and θ = πv, are taken in quarter turns ([`sin_cos_quarter_turns`]: polynomials, no
-/// library calls).
+/// [`uv_to_direction`] and the sin θ it computes on the way. The angles, θ = πv and
+/// φ = π(2u − 1), are taken in quarter turns, together ([`sin_cos_quarter_turns_pair`]:
+/// polynomials in SIMD lanes, no library calls).
 #[inline]
 fn uv_to_direction_sin(uv: Vec2) -> (Vec3, f32) {
-    let (st, ct) = sin_cos_quarter_turns(2.0 * uv.y);
-    let (sp, cp) = sin_cos_quarter_turns(4.0 * uv.x - 2.0);
+    let [(st, ct), (sp, cp)] = sin_cos_quarter_turns_pair(Vec2::new(2.0 * uv.y, 4.0 * uv.x - 2.0));
     (Vec3::new(st * sp, ct, -st * cp), st)
 }
 
