@@ -53,7 +53,8 @@ const ROUND_TO_INTEGER: f32 = 12_582_912.0;
 /// (s, c) = (sin r, cos r) turned by `q` quarter turns: (sin, cos) of r + q·π/2.
 #[inline]
 fn quarter_turned(q: f32, s: f32, c: f32) -> (f32, f32) {
-    match (q as i32) & 3 {
+    // q is a whole number of magnitude under 2²², so the fast truncation is exact.
+    match truncate_to_i32(q) & 3 {
         0 => (s, c),
         1 => (c, -s),
         2 => (-s, -c),
@@ -195,6 +196,32 @@ pub fn power_heuristic(pdf_f: f32, pdf_g: f32) -> f32 {
         return 1.0;
     }
     f / (f + g)
+}
+
+/// `x` truncated towards zero, as `x as i32` for |x| < 2³¹. On x86-64 by SSE2's one
+/// truncating conversion, where `as` adds the saturation's tests and moves (five or six
+/// instructions): NaN and values out of range give −2³¹ there (`as` saturates; other
+/// targets use `as`).
+#[inline(always)]
+pub(crate) fn truncate_to_i32(x: f32) -> i32 {
+    #[cfg(target_arch = "x86_64")]
+    {
+        use std::arch::x86_64::{_mm_cvttss_si32, _mm_set_ss};
+        // SAFETY: SSE2 is part of x86-64.
+        unsafe { _mm_cvttss_si32(_mm_set_ss(x)) }
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    {
+        x as i32
+    }
+}
+
+/// `x as usize` for `x` in [0, 2³¹) (the callers clamp it to a table's size), by
+/// [`truncate_to_i32`]: NaN, negatives and values past 2³¹ − 1 give 2³¹ on x86-64, which
+/// the callers' `min` with the last cell keeps in bounds.
+#[inline(always)]
+pub(crate) fn cell_index(x: f32) -> usize {
+    truncate_to_i32(x) as u32 as usize
 }
 
 /// Walker's alias method, built with Vose's stable algorithm: O(n) build, O(1) sample.
@@ -376,14 +403,15 @@ impl Distribution1D {
     /// probability is its density (as [`Self::pdf`] gives it) over the number of cells.
     ///
     /// Always inlined (the environment's two steps called it out of line, ~15 of its ~70
-    /// instructions the call); the guide's index converts through `u32`, half the
-    /// saturating `f32 → usize` sequence, the same index for tables under 2³² cells.
+    /// instructions the call); the guide's index by [`cell_index`], one instruction where
+    /// the saturating `f32 → usize` takes several, the same index for tables under 2³¹
+    /// cells.
     #[inline(always)]
     pub fn sample_cell(&self, u: f32) -> (usize, f32) {
         let n = self.func.len();
         // The last cell whose CDF start is <= u, from the guide's cell for u's n-th of
         // [0, 1). The step back is for the rounding of u·n up to the next entry.
-        let mut i = self.guide[((u * n as f32) as u32 as usize).min(n - 1)] as usize;
+        let mut i = self.guide[cell_index(u * n as f32).min(n - 1)] as usize;
         while i > 0 && self.cdf[i] > u {
             i -= 1;
         }

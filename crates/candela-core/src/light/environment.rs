@@ -154,17 +154,17 @@ impl LightSource for EnvironmentLight {
         self.eval(ray.d.normalize())
     }
 
-    /// The equirect map's radiance and density from one lookup of its grid; a constant
-    /// map's without normalising or rotating the direction.
+    /// The radiance and density from one lookup of the map (the equirect map's grid, the
+    /// cube map's face); a constant map's without normalising or rotating the direction.
     fn le_pdf(&self, ctx: &ShadingCtx, ray: &Ray) -> (Vec3, f32) {
-        match (&self.map, self.sampling) {
-            (EnvironmentMap::Constant(c), _) => (self.strength * *c, UNIFORM_SPHERE_PDF),
-            (EnvironmentMap::Equirect(m), EnvironmentSampling::Importance) => {
-                let (l, pdf) = m.eval_pdf(self.map_from_world * ray.d.normalize());
-                (self.strength * l, pdf)
-            }
-            _ => (self.le(ray), self.pdf_li(ctx, ray.d)),
-        }
+        let local = || self.map_from_world * ray.d.normalize();
+        let (l, pdf) = match (&self.map, self.sampling) {
+            (EnvironmentMap::Constant(c), _) => return (self.strength * *c, UNIFORM_SPHERE_PDF),
+            (EnvironmentMap::Equirect(m), EnvironmentSampling::Importance) => m.eval_pdf(local()),
+            (EnvironmentMap::Cubemap(m), EnvironmentSampling::Importance) => m.eval_pdf(local()),
+            (_, EnvironmentSampling::Uniform) => return (self.le(ray), self.pdf_li(ctx, ray.d)),
+        };
+        (self.strength * l, pdf)
     }
 
     fn sample_li(&self, _ctx: &ShadingCtx, u: Vec2) -> Option<LightSample> {

@@ -15,7 +15,7 @@
 
 use glam::Vec2;
 
-use crate::sampling::{sample_bilinear, Distribution1D, ONE_MINUS_EPSILON};
+use crate::sampling::{cell_index, sample_bilinear, Distribution1D, ONE_MINUS_EPSILON};
 
 /// `n` as an `f32`: the value of `n as f32`, for the grid sizes here (below 2³²), by way
 /// of `u32`, whose conversion on x86-64 is one instruction where `usize`'s tests the sign
@@ -24,14 +24,6 @@ use crate::sampling::{sample_bilinear, Distribution1D, ONE_MINUS_EPSILON};
 fn size_f32(n: usize) -> f32 {
     debug_assert!(u32::try_from(n).is_ok());
     n as u32 as f32
-}
-
-/// `x as usize` for `x` below 2³² (the callers clamp it to a grid size; 0 for NaN and
-/// negatives, as `as usize`), by way of `u32`: on x86-64 half the instructions of the
-/// saturating conversion to `usize`, which also handles values past 2⁶³.
-#[inline(always)]
-pub(super) fn cell_index(x: f32) -> usize {
-    x as u32 as usize
 }
 
 /// Where the vertices of one axis of a [`Bilinear2D`] grid lie on [0, 1].

@@ -148,6 +148,18 @@ impl Cubemap {
     /// Solid-angle density of [`Self::sample`] towards direction `d`.
     pub fn pdf(&self, d: Vec3) -> f32 {
         let (f, st) = direction_to_face(d);
+        self.pdf_on_face(f, st)
+    }
+
+    /// The radiance towards direction `d` and the solid-angle density with which
+    /// [`Self::sample`] draws `d`: [`Self::eval`] and [`Self::pdf`] from one face lookup.
+    pub fn eval_pdf(&self, d: Vec3) -> (Vec3, f32) {
+        let (f, st) = direction_to_face(d);
+        (self.faces[f].bilinear(st, false), self.pdf_on_face(f, st))
+    }
+
+    /// Solid-angle density of [`Self::sample`] at coordinates `st` of face `f`.
+    fn pdf_on_face(&self, f: usize, st: Vec2) -> f32 {
         let pmf = self.face_distribution.pdf((f as f32 + 0.5) / 6.0) / 6.0;
         pmf * self.distributions[f].pdf(st) / solid_angle_jacobian(st)
     }

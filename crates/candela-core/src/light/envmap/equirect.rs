@@ -129,13 +129,25 @@ impl Equirect {
     }
 
     /// The grid vertices at the corners of the cell of column `k`, row `j`: top left,
-    /// top right, bottom left, bottom right. One bounds check for the four.
+    /// top right, bottom left, bottom right. One bounds check for the four (slicing
+    /// them out, then indexing the slice, took six).
     #[inline]
     fn cell(&self, k: usize, j: usize) -> [Vec4; 4] {
         let stride = self.image.width + 1;
         let i = j * stride + k;
-        let c = &self.grid[i..i + stride + 2];
-        [c[0], c[1], c[stride], c[stride + 1]]
+        assert!(
+            i < self.grid.len().saturating_sub(stride + 1),
+            "cell ({k}, {j}) outside the grid"
+        );
+        // SAFETY: i + stride + 1 < len, checked above; the other three are smaller.
+        unsafe {
+            [
+                *self.grid.get_unchecked(i),
+                *self.grid.get_unchecked(i + 1),
+                *self.grid.get_unchecked(i + stride),
+                *self.grid.get_unchecked(i + stride + 1),
+            ]
+        }
     }
 
     /// Radiance and sampling function, blended at grid point `p`.
