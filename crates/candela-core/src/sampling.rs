@@ -405,22 +405,30 @@ impl Distribution1D {
     /// Always inlined (the environment's two steps called it out of line, ~15 of its ~70
     /// instructions the call); the guide's index by [`cell_index`], one instruction where
     /// the saturating `f32 → usize` takes several, the same index for tables under 2³¹
-    /// cells.
+    /// cells. The tables are read without bounds checks (one or two compares and a branch
+    /// each, six or more a call): `new` makes every index here provably in bounds.
     #[inline(always)]
     pub fn sample_cell(&self, u: f32) -> (usize, f32) {
         let n = self.func.len();
+        // SAFETY: `new` builds `guide` with n entries, each below n, and `cdf` with n + 1,
+        // and nothing changes them after. So the guide's index (below n by the `min`; n ≥ 1)
+        // and every i below (below n: from the guide, then only decreased to 0 or increased
+        // while i + 1 < n) are in bounds, and so is i + 1 ≤ n in `cdf`.
+        let (guide, cdf) = (&self.guide, &self.cdf);
+        let at = |i: usize| unsafe { *cdf.get_unchecked(i) };
         // The last cell whose CDF start is <= u, from the guide's cell for u's n-th of
         // [0, 1). The step back is for the rounding of u·n up to the next entry.
-        let mut i = self.guide[cell_index(u * n as f32).min(n - 1)] as usize;
-        while i > 0 && self.cdf[i] > u {
+        let mut i = unsafe { *guide.get_unchecked(cell_index(u * n as f32).min(n - 1)) } as usize;
+        while i > 0 && at(i) > u {
             i -= 1;
         }
-        while i + 1 < n && self.cdf[i + 1] <= u {
+        while i + 1 < n && at(i + 1) <= u {
             i += 1;
         }
-        let width = self.cdf[i + 1] - self.cdf[i];
+        let (start, end) = (at(i), at(i + 1));
+        let width = end - start;
         let du = if width > 0.0 {
-            ((u - self.cdf[i]) / width).clamp(0.0, ONE_MINUS_EPSILON)
+            ((u - start) / width).clamp(0.0, ONE_MINUS_EPSILON)
         } else {
             0.0
         };

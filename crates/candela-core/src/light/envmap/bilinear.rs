@@ -186,8 +186,8 @@ impl Bilinear2D {
 
     /// A cell drawn with probability ∝ its share of ∫ f, as (column k, row j), and two
     /// numbers uniform on [0, 1)² left for placing the point within it; `None` when f is
-    /// zero everywhere.
-    #[inline]
+    /// zero everywhere. Always inlined: out of line, its result went back through memory.
+    #[inline(always)]
     pub fn sample_cell(&self, u: Vec2) -> Option<(usize, usize, Vec2)> {
         if self.integral <= 0.0 {
             return None;

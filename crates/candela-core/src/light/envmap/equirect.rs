@@ -43,7 +43,7 @@ pub fn direction_to_uv(d: Vec3) -> Vec2 {
 /// atan2(sin θ, cos θ); both angles by [`atan2_poly_lanes`], in two lanes of one pass:
 /// bit for bit [`crate::math::atan2_poly`], a third of libm's `atan2f` and `acosf`, as
 /// accurate).
-#[inline]
+#[inline(always)]
 fn direction_to_uv_sin(d: Vec3) -> (Vec2, f32) {
     let sin_theta = (d.x * d.x + d.z * d.z).sqrt();
     let angles = atan2_poly_lanes(
@@ -122,7 +122,7 @@ impl Equirect {
     }
 
     /// The grid's coordinates of `uv`: columns start half a texel to the right of u = 0.
-    #[inline]
+    #[inline(always)]
     fn grid_point(&self, uv: Vec2) -> Vec2 {
         let x = uv.x - self.half_texel;
         Vec2::new(if x < 0.0 { x + 1.0 } else { x }, uv.y)
@@ -151,7 +151,7 @@ impl Equirect {
     }
 
     /// Radiance and sampling function, blended at grid point `p`.
-    #[inline]
+    #[inline(always)]
     fn lookup(&self, p: Vec2) -> Vec4 {
         let (k, s) = GridAxis::Even(self.image.width).locate(p.x);
         let (j, t) = GridAxis::Centred(self.image.height).locate(p.y);
