@@ -403,7 +403,7 @@ impl Distribution1D {
     /// probability is its density (as [`Self::pdf`] gives it) over the number of cells.
     ///
     /// Always inlined (the environment's two steps called it out of line, ~15 of its ~70
-    /// instructions the call); the guide's index by [`cell_index`], one instruction where
+    /// instructions the call); the guide's index by `cell_index`, one instruction where
     /// the saturating `f32 → usize` takes several, the same index for tables under 2³¹
     /// cells. The tables are read without bounds checks (one or two compares and a branch
     /// each, six or more a call): `new` makes every index here provably in bounds.
