@@ -186,13 +186,19 @@ impl WatertightRay {
     /// slips between two triangles that share an edge. Returns a hit with 0 < t < t_max.
     ///
     /// The test as the paper has it (vertices moved to the ray's frame, 2D edge functions
-    /// never fused, an exactly zero one retried in double precision), its distance test
-    /// written with fewer operations and the same outcome: the determinant's sign folded
-    /// into the scaled distance (sign-bit flips, exact), then one comparison with zero
-    /// and one with `t_max · |det|`, where the paper picks one of two pairs by the sign.
-    /// The block kernels ([`crate::accel`]) perform the same operations in the same
-    /// order, so every lane gives these bits (and the decisions and bits of the paper's
-    /// order: the block tests' results are unchanged).
+    /// never fused), with two changes. An edge function that rounds to exactly zero
+    /// counts as inside, without the paper's double-precision retry: the two triangles
+    /// that share an edge compute its function from the same two transformed vertices
+    /// with the operands swapped (products commute, and `x − y = −(y − x)` exactly), so
+    /// where one sees a nonzero value the other sees its negation and exactly one of them
+    /// is hit, and where both see zero both are: a ray may meet either or both, never
+    /// neither (watertight without the retry, which cost every vector lane three
+    /// comparisons and a scalar fallback). And the distance test written with fewer
+    /// operations and the same outcome: the determinant's sign folded into the scaled
+    /// distance (sign-bit flips, exact), then one comparison with zero and one with
+    /// `t_max · |det|`, where the paper picks one of two pairs by the sign. The block
+    /// kernels ([`crate::accel`]) perform the same operations in the same order, so every
+    /// lane gives these bits.
     #[inline]
     pub fn intersect(&self, p0: Vec3, p1: Vec3, p2: Vec3, t_max: f32) -> Option<TriangleHit> {
         let (kx, ky, kz) = (self.kx, self.ky, self.kz);
@@ -206,19 +212,11 @@ impl WatertightRay {
         let by = b[ky] - sy * b[kz];
         let cx = c[kx] - sx * c[kz];
         let cy = c[ky] - sy * c[kz];
-        let mut u = cx * by - cy * bx;
-        let mut v = ax * cy - ay * cx;
-        let mut w = bx * ay - by * ax;
-        if u == 0.0 || v == 0.0 || w == 0.0 {
-            // Fall back to double precision on the edges, as the paper does: the products
-            // are exact there, so the sign of each edge function is.
-            let (axd, ayd, bxd, byd, cxd, cyd) = (
-                ax as f64, ay as f64, bx as f64, by as f64, cx as f64, cy as f64,
-            );
-            u = (cxd * byd - cyd * bxd) as f32;
-            v = (axd * cyd - ayd * cxd) as f32;
-            w = (bxd * ayd - byd * axd) as f32;
-        }
+        let u = cx * by - cy * bx;
+        let v = ax * cy - ay * cx;
+        let w = bx * ay - by * ax;
+        // Outside where some edge function is negative and another positive: a zero one
+        // (the ray through an edge or vertex, or a value that rounds to zero) is inside.
         if u.min(v).min(w) < 0.0 && u.max(v).max(w) > 0.0 {
             return None;
         }
@@ -474,9 +472,8 @@ mod tests {
     }
 
     /// No ray slips through a closed mesh, above all where it passes exactly through a
-    /// shared vertex or edge (edge functions that round to zero: the double-precision
-    /// retry): rays from
-    /// inside the cube, in any direction and aimed at vertices and edge midpoints, and
+    /// shared vertex or edge (edge functions that round to zero, which count as inside):
+    /// rays from inside the cube, in any direction and aimed at vertices and edge midpoints, and
     /// rays from outside whose line passes exactly (dyadic coordinates, an unnormalized
     /// direction computed without rounding) through a vertex or an edge's midpoint on its
     /// way to an inside point, all meet the surface; on the jittered cube too. Every hit's

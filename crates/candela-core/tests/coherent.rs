@@ -2,7 +2,7 @@
 //! (`Accel::intersect`) on the same rays: every ray's hit must be the same bit for bit
 //! (primitive, distance, barycentrics), ties included: the scenes hold duplicated
 //! triangles (two primitives at the very same distance) and triangles sharing edges and
-//! vertices that rays aim at (exactly zero edge functions: the double-precision retry).
+//! vertices that rays aim at (exactly zero edge functions, which count as inside).
 //! Trees of one leaf, of one node over several leaves (the packet paths) and of several
 //! nodes (single queries), with spheres and alpha-masked triangles whose filter depends
 //! on the ray (so each ray must be asked about with its own), in coherent packets (one

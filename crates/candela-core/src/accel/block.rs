@@ -5,9 +5,9 @@
 //!
 //! The vector test performs exactly the operations of [`WatertightRay::intersect`] in
 //! the same order (Rust never fuses a multiply and an add on its own), so each lane's
-//! distance and barycentrics are the same bits as the scalar test's. Lanes where an edge
-//! function is exactly zero take the scalar test, which retries those in double precision
-//! as the paper does. Sphere lanes take the vector sphere test ([`super::sphere`]) in the
+//! distance and barycentrics are the same bits as the scalar test's (an edge function
+//! that is exactly zero counts as inside in both, without a retry, so no lane leaves
+//! the vector test). Sphere lanes take the vector sphere test ([`super::sphere`]) in the
 //! same pass, with the same bits as the scalar one; a filtered-triangle lane takes the
 //! scalar test inside the vector path (the block's triangles are still tested together),
 //! and everything under [`Simd::Scalar`] goes lane by lane: the reference the tests
@@ -285,10 +285,10 @@ impl Block {
         let used = (1u32 << count) - 1;
         let mut out = MaybeUninit::<Lanes>::uninit();
         let out = out.as_mut_ptr();
-        let (hit, edge) = if KERNEL == AVX2 {
+        let hit = if KERNEL == AVX2 {
             self.test_lanes::<__m256, ANY, MIXED>(ray, w, 0, used, spheres, live, t_max, out)
         } else {
-            let (h0, e0) = self.test_lanes::<__m128, ANY, MIXED>(
+            let h0 = self.test_lanes::<__m128, ANY, MIXED>(
                 ray,
                 w,
                 0,
@@ -300,9 +300,9 @@ impl Block {
             );
             // (A special lane's bit says nothing: only a triangle's hit ends a shadow ray.)
             if count <= 4 || (ANY && h0 & !special != 0) {
-                (h0, e0)
+                h0
             } else {
-                let (h1, e1) = self.test_lanes::<__m128, ANY, MIXED>(
+                let h1 = self.test_lanes::<__m128, ANY, MIXED>(
                     ray,
                     w,
                     4,
@@ -312,12 +312,12 @@ impl Block {
                     t_max,
                     out,
                 );
-                (h0 | h1, e0 | e1)
+                h0 | h1
             }
         };
         // What the vector test says of a special lane is not about its primitive.
-        let (hit, edge) = (hit & !special, edge & !special);
-        if hit | edge | special == 0 {
+        let hit = hit & !special;
+        if hit | special == 0 {
             return None;
         }
         // SAFETY: `test_lanes` wrote `t` (and without `ANY`, `b1` and `b2`) in every
@@ -330,7 +330,7 @@ impl Block {
         // lanes a hit block on the Cornell render, which the loop below would find with
         // its bookkeeping (callgrind, Cornell 128² 1 spp: 573.9 -> 569.5 instructions a
         // closest-hit query).
-        let alone = hit & hit.wrapping_sub(1) == 0 && edge | special == 0;
+        let alone = hit & hit.wrapping_sub(1) == 0 && special == 0;
         if hit != 0 && (ANY || alone) {
             let lane = hit.trailing_zeros() as usize;
             let (b1, b2) = if ANY {
@@ -348,15 +348,12 @@ impl Block {
         }
         let mut best = None;
         let mut best_t = t_max;
-        let mut todo = hit | edge | special;
+        let mut todo = hit | special;
         while todo != 0 {
             let lane = todo.trailing_zeros() as usize;
             todo &= todo - 1;
             let found = if special & (1 << lane) != 0 {
                 self.lane_test(ray, w, lane, best_t, filter)
-            } else if edge & (1 << lane) != 0 {
-                let [p0, p1, p2] = [0, 1, 2].map(|k| self.vertex(k, lane));
-                w.intersect(p0, p1, p2, best_t)
             } else if t(lane) < best_t {
                 Some(TriangleHit {
                     t: t(lane),
@@ -383,10 +380,8 @@ impl Block {
     /// [`WatertightRay::intersect`] on the `V::LANES` lanes from `first` on (`used`: the
     /// filled ones, bit 0 = lane `first`) that `spheres` does not name (bits of the
     /// block's lanes), and [`intersect_sphere`] on those that `live` (a part of
-    /// `spheres`) names: which are hit without an
-    /// exactly-zero edge function, and which triangles have one (for the scalar retry),
-    /// as bits of the block's lanes. Where some lane is either, the distances (and
-    /// without `ANY` the barycentrics, zero for a sphere) go to `out`.
+    /// `spheres`) names: which are hit, as bits of the block's lanes. Where some lane is,
+    /// the distances (and without `ANY` the barycentrics, zero for a sphere) go to `out`.
     ///
     /// # Safety
     /// The CPU must support `V`; `first + V::LANES <= LANES`.
@@ -403,7 +398,7 @@ impl Block {
         live: u32,
         t_max: f32,
         out: *mut Lanes,
-    ) -> (u32, u32) {
+    ) -> u32 {
         debug_assert!(first + V::LANES <= LANES);
         let row = |r: *mut [f32; LANES]| (r as *mut f32).add(first);
         let zero = V::splat(0.0);
@@ -428,14 +423,14 @@ impl Block {
         let tris = used & !sph;
         if MIXED && tris == 0 {
             if sphere_bits == 0 {
-                return (0, 0);
+                return 0;
             }
             sphere_t.store(row(std::ptr::addr_of_mut!((*out).t)));
             if !ANY {
                 zero.store(row(std::ptr::addr_of_mut!((*out).b1)));
                 zero.store(row(std::ptr::addr_of_mut!((*out).b2)));
             }
-            return (sphere_bits << first, 0);
+            return sphere_bits << first;
         }
         let (kx, ky, kz) = (w.kx, w.ky, w.kz);
         let (ox, oy, oz) = (V::splat(w.o_k.x), V::splat(w.o_k.y), V::splat(w.o_k.z));
@@ -463,11 +458,8 @@ impl Block {
         let v = ax.mul(cy).sub(ay.mul(cx));
         let ww = bx.mul(ay).sub(by.mul(ax));
         // Unused lanes need no mask here: their NaN vertices give NaN edge functions and
-        // distances, which are neither zero nor in range. Sphere lanes' are not about a
-        // triangle.
-        let on_edge = u.eq(zero).or(v.eq(zero)).or(ww.eq(zero)).bits();
-        let on_edge = if MIXED { on_edge & !sph } else { on_edge };
-        // Some edge function negative and some positive: the scalar test's six
+        // distances, which no lane passes. Sphere lanes' are not about a triangle (masked
+        // below). Some edge function negative and some positive: the scalar test's six
         // comparisons as the sign of the least and the greatest. (They differ only where
         // one is NaN, and there `det` and `t` are NaN too, which no lane passes.)
         let mixed_signs = u.min(v).min(ww).lt(zero).and(u.max(v).max(ww).gt(zero));
@@ -485,19 +477,19 @@ impl Block {
         let t_max_v = V::splat(t_max);
         let before = t_signed.gt(t_max_v.mul(det_abs)).andnot(t_signed.gt(zero));
         let passed = mixed_signs.andnot(before);
-        if !ANY && passed.bits() & tris | on_edge | sphere_bits == 0 {
+        if !ANY && passed.bits() & tris | sphere_bits == 0 {
             // Every lane is rejected before the division, as in the scalar test (for a
             // shadow ray, whose blocks are hit more often, the check costs more than it
             // saves: callgrind, any-hit instructions per ray on the room 468 -> 480).
-            return (0, 0);
+            return 0;
         }
         let inv_det = V::splat(1.0).div(det);
         let t = t_scaled.mul(inv_det);
         let in_range = t.gt(zero).and(t.lt(t_max_v));
-        let hit = passed.and(in_range).bits() & !on_edge;
+        let hit = passed.and(in_range).bits();
         let hit = if MIXED { hit & !sph | sphere_bits } else { hit };
-        if hit | on_edge == 0 {
-            return (0, 0);
+        if hit == 0 {
+            return 0;
         }
         let (t, b1, b2) = (t, v.mul(inv_det), ww.mul(inv_det));
         let (t, b1, b2) = if MIXED {
@@ -514,7 +506,7 @@ impl Block {
             b1.store(row(std::ptr::addr_of_mut!((*out).b1)));
             b2.store(row(std::ptr::addr_of_mut!((*out).b2)));
         }
-        (hit << first, on_edge << first)
+        hit << first
     }
 }
 
@@ -615,8 +607,8 @@ mod tests {
     /// filtered triangles in: each kernel the CPU has returns the scalar kernel's lane,
     /// distance and barycentrics bit for bit, and that is the nearest hit of a plain loop
     /// over `WatertightRay::intersect` (the lowest lane among equal distances). Rays aim
-    /// at points inside the triangles, at their vertices (exactly zero edge functions:
-    /// the double-precision retry) and along the axes.
+    /// at points inside the triangles, at their vertices (exactly zero edge functions,
+    /// which count as inside) and along the axes.
     #[test]
     fn every_kernel_gives_the_scalar_bits_at_every_fill() {
         let mut rng = Pcg32::new(8, 8);

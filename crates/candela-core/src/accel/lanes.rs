@@ -31,7 +31,6 @@ pub trait Wide: Copy {
     unsafe fn xor(self, o: Self) -> Self;
     /// `!self & o`.
     unsafe fn andnot(self, o: Self) -> Self;
-    unsafe fn eq(self, o: Self) -> Self;
     unsafe fn lt(self, o: Self) -> Self;
     unsafe fn gt(self, o: Self) -> Self;
     unsafe fn ge(self, o: Self) -> Self;
@@ -106,10 +105,6 @@ impl Wide for __m128 {
         _mm_andnot_ps(self, o)
     }
     #[inline(always)]
-    unsafe fn eq(self, o: Self) -> Self {
-        _mm_cmpeq_ps(self, o)
-    }
-    #[inline(always)]
     unsafe fn lt(self, o: Self) -> Self {
         _mm_cmplt_ps(self, o)
     }
@@ -163,7 +158,6 @@ impl Wide for __m256 {
         fn or(self: Self, o: Self) -> Self { _mm256_or_ps(self, o) }
         fn xor(self: Self, o: Self) -> Self { _mm256_xor_ps(self, o) }
         fn andnot(self: Self, o: Self) -> Self { _mm256_andnot_ps(self, o) }
-        fn eq(self: Self, o: Self) -> Self { _mm256_cmp_ps::<_CMP_EQ_OQ>(self, o) }
         fn lt(self: Self, o: Self) -> Self { _mm256_cmp_ps::<_CMP_LT_OQ>(self, o) }
         fn gt(self: Self, o: Self) -> Self { _mm256_cmp_ps::<_CMP_GT_OQ>(self, o) }
         fn ge(self: Self, o: Self) -> Self { _mm256_cmp_ps::<_CMP_GE_OQ>(self, o) }

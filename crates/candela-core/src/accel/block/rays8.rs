@@ -9,8 +9,7 @@
 //! the ray's nearest so far (the lowest lane among equal distances); the distance range
 //! of the vector test the ray's `t_max` on entering the block, as the single-ray vector
 //! test has it. What the single-ray test hands to its scalar code goes to the same scalar
-//! code here, ray by ray: edge functions exactly zero (the double-precision retry), and
-//! filtered triangles ([`Block::lane_test`]). A sphere takes a vector test of its own
+//! code here, ray by ray: filtered triangles ([`Block::lane_test`]). A sphere takes a vector test of its own
 //! against the eight rays, the scalar [`intersect_sphere`]'s operations in each lane.
 
 use std::arch::x86_64::*;
@@ -21,7 +20,7 @@ use crate::geometry::intersect_sphere;
 use crate::geometry::{Ray, TriangleHit, WatertightRay};
 
 /// Eight rays as [`Block::intersect_rays8`] reads them: the rays (for the scalar
-/// retries, which make their watertight constants again: the same bits) and, component
+/// tests of filtered triangles, which make their watertight constants again: the same bits) and, component
 /// by component in lanes, their origins, directions and watertight constants.
 pub(crate) struct Rays8<'a> {
     pub rays: &'a [Ray; 8],
@@ -284,11 +283,6 @@ impl Block {
             let u = _mm256_sub_ps(_mm256_mul_ps(cx, by), _mm256_mul_ps(cy, bx));
             let v = _mm256_sub_ps(_mm256_mul_ps(ax, cy), _mm256_mul_ps(ay, cx));
             let ww = _mm256_sub_ps(_mm256_mul_ps(bx, ay), _mm256_mul_ps(by, ax));
-            let eq0 = |a| _mm256_cmp_ps::<_CMP_EQ_OQ>(a, zero);
-            let on_edge = _mm256_and_ps(
-                _mm256_or_ps(_mm256_or_ps(eq0(u), eq0(v)), eq0(ww)),
-                in_group,
-            );
             let mixed_signs = _mm256_and_ps(
                 _mm256_cmp_ps::<_CMP_LT_OQ>(_mm256_min_ps(_mm256_min_ps(u, v), ww), zero),
                 _mm256_cmp_ps::<_CMP_GT_OQ>(_mm256_max_ps(_mm256_max_ps(u, v), ww), zero),
@@ -308,11 +302,7 @@ impl Block {
                 _mm256_cmp_ps::<_CMP_GT_OQ>(t_signed, _mm256_mul_ps(t_max, det_abs)),
                 _mm256_cmp_ps::<_CMP_GT_OQ>(t_signed, zero),
             );
-            let edge = _mm256_movemask_ps(on_edge) as u32;
-            let open = _mm256_andnot_ps(
-                _mm256_or_ps(mixed_signs, on_edge),
-                _mm256_and_ps(before, in_group),
-            );
+            let open = _mm256_andnot_ps(mixed_signs, _mm256_and_ps(before, in_group));
             if _mm256_movemask_ps(open) != 0 {
                 // Some ray of the group passes the tests before the division.
                 let inv_det = _mm256_div_ps(_mm256_set1_ps(1.0), det);
@@ -334,17 +324,6 @@ impl Block {
                     bid = _mm256_blendv_ps(bid, idv, take);
                     found |= taken;
                 }
-            }
-            if edge != 0 {
-                spilled!({
-                    let [p0, p1, p2] = [0, 1, 2].map(|k| self.vertex(k, lane));
-                    for r in bits(edge) {
-                        let w = WatertightRay::new(&rays.rays[r]);
-                        if let Some(h) = w.intersect(p0, p1, p2, best.t[r]) {
-                            best.take(r, id & ID_MASK, &h);
-                        }
-                    }
-                });
             }
         }
         _mm256_storeu_ps(best.t.as_mut_ptr(), bt);
