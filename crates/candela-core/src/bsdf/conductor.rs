@@ -4,7 +4,7 @@
 use glam::{Vec2, Vec3};
 
 use super::fresnel::{fresnel_conductor, fresnel_schlick, reflect};
-use super::microfacet::{reflection_half_vector, Microfacet, MicrofacetDistribution};
+use super::microfacet::{Microfacet, MicrofacetDistribution};
 use super::{BsdfFlags, BsdfSample};
 
 /// How a conductor's reflectance depends on the angle.
@@ -62,17 +62,9 @@ impl Conductor {
         if self.is_delta() || wo.z <= 0.0 || wi.z <= 0.0 {
             return (Vec3::ZERO, 0.0);
         }
-        let Some(wm) = reflection_half_vector(wo, wi) else {
+        let Some((wm, dg, pdf)) = self.distrib.reflection(wo, wi) else {
             return (Vec3::ZERO, 0.0);
         };
-        self.f_pdf_about(wo, wi, wm)
-    }
-
-    /// [`Self::f_pdf`] of a pair of the upper hemisphere about its half vector `wm`
-    /// (derived from the pair, or the sampled normal that reflected `wo` into `wi`).
-    #[inline(always)]
-    fn f_pdf_about(&self, wo: Vec3, wi: Vec3, wm: Vec3) -> (Vec3, f32) {
-        let (dg, pdf) = self.distrib.reflection_about(wo, wi, wm);
         (self.fresnel.eval(wo.dot(wm)) * dg, pdf)
     }
 
@@ -94,9 +86,7 @@ impl Conductor {
         if wi.z <= 0.0 {
             return None;
         }
-        // f and pdf about the sampled normal, not the half vector derived again from the
-        // pair (the same normal but for rounding): a normalization less.
-        let (f, pdf) = self.f_pdf_about(wo, wi, wm);
+        let (f, pdf) = self.f_pdf(wo, wi);
         (pdf > 0.0).then_some(BsdfSample {
             f,
             wi,

@@ -31,7 +31,7 @@ impl Dielectric {
     /// The half vector of a reflection or refraction pair, on the +z side, and the
     /// relative index η' crossed (1 for reflection). `None` for degenerate pairs and for
     /// back-facing microfacets.
-    fn half_vector(&self, wo: Vec3, wi: Vec3) -> Option<(Vec3, f32)> {
+    fn half_vector(&self, wo: Vec3, wi: Vec3) -> Option<(Vec3, f32, bool)> {
         let (co, ci) = (wo.z, wi.z);
         if co == 0.0 || ci == 0.0 {
             return None;
@@ -51,10 +51,10 @@ impl Dielectric {
         if wm.z < 0.0 {
             wm = -wm;
         }
-        if back_facing(wm, wo, wi) {
+        if wm.dot(wi) * ci < 0.0 || wm.dot(wo) * co < 0.0 {
             return None;
         }
-        Some((wm, etap))
+        Some((wm, etap, reflect))
     }
 
     pub fn f(&self, wo: Vec3, wi: Vec3) -> Vec3 {
@@ -71,23 +71,12 @@ impl Dielectric {
         if self.is_delta() {
             return (Vec3::ZERO, 0.0);
         }
-        let Some((wm, etap)) = self.half_vector(wo, wi) else {
+        let Some((wm, etap, reflect)) = self.half_vector(wo, wi) else {
             return (Vec3::ZERO, 0.0);
         };
-        let fr = fresnel_dielectric(wo.dot(wm), self.eta);
-        self.f_pdf_about(wo, wi, wm, etap, fr)
-    }
-
-    /// [`Self::f_pdf`] of a pair about its half vector `wm` (on the +z side, facing both
-    /// directions: not `back_facing`), of relative index `etap` crossed (1 for a
-    /// reflection) and Fresnel reflectance `fr` = F(ωo·ωm): derived from the pair, or the
-    /// sampled normal that reflected or refracted `wo` into `wi`, with the Fresnel term
-    /// that chose between the two.
-    #[inline(always)]
-    fn f_pdf_about(&self, wo: Vec3, wi: Vec3, wm: Vec3, etap: f32, fr: f32) -> (Vec3, f32) {
-        let reflect = wo.z * wi.z > 0.0;
         let t = self.distrib.pair(wo, wi, wm);
         let (d, g) = (t.d, t.g());
+        let fr = fresnel_dielectric(wo.dot(wm), self.eta);
         let dv = t.d_visible(wo, wm);
         if reflect {
             let f = Vec3::splat(d * g * fr / (4.0 * wo.z * wi.z).abs());
@@ -110,27 +99,20 @@ impl Dielectric {
         }
         let wm = self.distrib.sample_wm(wo, u);
         let r = fresnel_dielectric(wo.dot(wm), self.eta);
-        let (wi, etap, flags) = if u_lobe < r {
+        let (wi, flags) = if u_lobe < r {
             let wi = reflect(wo, wm);
             if wi.z * wo.z <= 0.0 {
                 return None;
             }
-            (wi, 1.0, BsdfFlags::REFLECTION)
+            (wi, BsdfFlags::REFLECTION)
         } else {
-            let (wi, etap) = refract(wo, wm, self.eta)?;
+            let (wi, _) = refract(wo, wm, self.eta)?;
             if wi.z * wo.z >= 0.0 {
                 return None;
             }
-            (wi, etap, BsdfFlags::TRANSMISSION)
+            (wi, BsdfFlags::TRANSMISSION)
         };
-        // f and pdf about the sampled normal and with its Fresnel term, not the half
-        // vector and F derived again from the pair (the same but for rounding): a
-        // normalization and a Fresnel term less. The sampled normal is visible from ωo, so
-        // it faces ωi too but for rounding, which the check rejects as `f_pdf` would.
-        if back_facing(wm, wo, wi) {
-            return None;
-        }
-        let (f, pdf) = self.f_pdf_about(wo, wi, wm, etap, r);
+        let (f, pdf) = self.f_pdf(wo, wi);
         (pdf > 0.0).then_some(BsdfSample {
             f,
             wi,
@@ -161,14 +143,6 @@ impl Dielectric {
             })
         }
     }
-}
-
-/// Whether the microfacet normal `wm` (on the +z side) turns its back to `wo` or `wi`,
-/// each seen from its own side of the surface: such a microfacet neither reflects nor
-/// refracts the pair.
-#[inline(always)]
-fn back_facing(wm: Vec3, wo: Vec3, wi: Vec3) -> bool {
-    wm.dot(wi) * wi.z < 0.0 || wm.dot(wo) * wo.z < 0.0
 }
 
 /// A thin dielectric sheet (a window pane): both faces smooth, light inside bounces

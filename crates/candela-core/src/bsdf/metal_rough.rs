@@ -5,7 +5,7 @@ use std::f32::consts::FRAC_1_PI;
 use glam::{Vec2, Vec3};
 
 use super::fresnel::{fresnel_schlick, reflect};
-use super::microfacet::{reflection_half_vector, MicrofacetDistribution, TrowbridgeReitz};
+use super::microfacet::{MicrofacetDistribution, TrowbridgeReitz};
 use super::{BsdfFlags, BsdfSample};
 use crate::sampling::{cosine_hemisphere_pdf, sample_cosine_hemisphere};
 
@@ -70,20 +70,11 @@ impl MetalRough {
         if wo.z <= 0.0 || wi.z <= 0.0 {
             return (Vec3::ZERO, 0.0);
         }
-        self.f_pdf_from(wo, wi, None)
-    }
-
-    /// [`Self::f_pdf`] of a pair in the upper hemisphere, with the specular lobe's half
-    /// vector where the caller has it (`sampled_wm`: the sampled normal that reflected
-    /// `wo` into `wi`; otherwise it is derived from the pair).
-    #[inline(always)]
-    fn f_pdf_from(&self, wo: Vec3, wi: Vec3, sampled_wm: Option<Vec3>) -> (Vec3, f32) {
         let ps = self.specular_probability(wo.z);
         let diffuse_pdf = (1.0 - ps) * cosine_hemisphere_pdf(wi.z);
-        let Some(wm) = sampled_wm.or_else(|| reflection_half_vector(wo, wi)) else {
+        let Some((wm, dg, specular_pdf)) = self.distrib.reflection(wo, wi) else {
             return (Vec3::ZERO, ps * 0.0 + diffuse_pdf);
         };
-        let (dg, specular_pdf) = self.distrib.reflection_about(wo, wi, wm);
         let f0 = self.f0();
         let spec = fresnel_schlick(f0, wo.dot(wm)) * dg;
         let transmit =
@@ -97,23 +88,15 @@ impl MetalRough {
             return None;
         }
         let ps = self.specular_probability(wo.z);
-        // A specular sample keeps its normal for f and pdf (see `f_pdf_from`).
-        let (wi, sampled_wm) = if u_lobe < ps {
-            let wm = self.distrib.sample_wm(wo, u);
-            // Seen from behind (by rounding only), the pair's half vector would be −ωm,
-            // where the specular D is 0 and the diffuse lobe would answer alone: reject it
-            // instead.
-            if wo.dot(wm) <= 0.0 {
-                return None;
-            }
-            (reflect(wo, wm), Some(wm))
+        let wi = if u_lobe < ps {
+            reflect(wo, self.distrib.sample_wm(wo, u))
         } else {
-            (sample_cosine_hemisphere(u), None)
+            sample_cosine_hemisphere(u)
         };
         if wi.z <= 0.0 {
             return None;
         }
-        let (f, pdf) = self.f_pdf_from(wo, wi, sampled_wm);
+        let (f, pdf) = self.f_pdf(wo, wi);
         let flags = if u_lobe < ps {
             BsdfFlags::GLOSSY
         } else {

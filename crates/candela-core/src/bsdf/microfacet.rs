@@ -70,21 +70,13 @@ pub trait MicrofacetDistribution {
     /// for ωm sampled by [`Self::sample_wm`] from ωo: D_ω(ωm)/(4 |ωo·ωm|), 1/(4 |ωo·ωm|)
     /// being the reflection's Jacobian dωm/dωi. `None` where ωo + ωi vanishes.
     fn reflection(&self, wo: Vec3, wi: Vec3) -> Option<(Vec3, f32, f32)> {
-        let wm = reflection_half_vector(wo, wi)?;
-        let (dg, pdf) = self.reflection_about(wo, wi, wm);
-        Some((wm, dg, pdf))
-    }
-
-    /// [`Self::reflection`]'s D·G/(4 cos θo cos θi) and density, about a half vector `wm`
-    /// the caller already has: the normal that [`Self::sample_wm`] drew and that
-    /// reflected ωo into ωi, which a sampler need not derive again from the pair (ωm is
-    /// then ωo + ωi normalized but for rounding). A back-facing `wm` (ωo·ωm ≤ 0) has
-    /// density 0.
-    #[inline(always)]
-    fn reflection_about(&self, wo: Vec3, wi: Vec3, wm: Vec3) -> (f32, f32) {
+        let wm = (wo + wi).normalize_or_zero();
+        if wm == Vec3::ZERO {
+            return None;
+        }
         let t = self.pair(wo, wi, wm);
         let dg = t.d * t.g() / (4.0 * wo.z * wi.z);
-        (dg, t.d_visible(wo, wm) / (4.0 * wo.dot(wm).abs()))
+        Some((wm, dg, t.d_visible(wo, wm) / (4.0 * wo.dot(wm).abs())))
     }
 
     /// Density of visible normals from `w`: G₁(ω)/|cos θ| · D(ωm) · |ω·ωm| (Heitz 2014,
@@ -95,14 +87,6 @@ pub trait MicrofacetDistribution {
     fn d_visible(&self, w: Vec3, wm: Vec3) -> f32 {
         visible_density(w, wm, self.g1(w), self.d(wm))
     }
-}
-
-/// The half vector (ωo + ωi)/|ωo + ωi| of a reflection pair; `None` where ωo + ωi
-/// vanishes.
-#[inline(always)]
-pub fn reflection_half_vector(wo: Vec3, wi: Vec3) -> Option<Vec3> {
-    let wm = (wo + wi).normalize_or_zero();
-    (wm != Vec3::ZERO).then_some(wm)
 }
 
 /// G₁ = 1/(1 + Λ).

@@ -5,7 +5,7 @@ use std::f32::consts::FRAC_1_PI;
 use glam::{Vec2, Vec3};
 
 use super::fresnel::{fresnel_dielectric, fresnel_diffuse_reflectance, reflect, refract};
-use super::microfacet::{reflection_half_vector, Microfacet, MicrofacetDistribution};
+use super::microfacet::{Microfacet, MicrofacetDistribution};
 use super::{BsdfFlags, BsdfSample};
 use crate::sampling::{cosine_hemisphere_pdf, sample_cosine_hemisphere};
 
@@ -138,34 +138,20 @@ impl Plastic {
             return (Vec3::ZERO, 0.0);
         }
         let t_o = self.coat_transmittance(wo.z);
-        self.f_pdf_from(t_o, self.specular_probability(t_o), wo, wi, None)
+        self.f_pdf_from(t_o, self.specular_probability(t_o), wo, wi)
     }
 
-    /// [`Self::f_pdf`] of a pair in the upper hemisphere, given T(θo) = `t_o`, the coat's
-    /// sampling probability `ps` from `wo`, and the coat's half vector where the caller
-    /// has it (`sampled_wm`: the sampled normal that reflected `wo` into `wi`; otherwise
-    /// it is derived from the pair).
-    #[inline(always)]
-    fn f_pdf_from(
-        &self,
-        t_o: f32,
-        ps: f32,
-        wo: Vec3,
-        wi: Vec3,
-        sampled_wm: Option<Vec3>,
-    ) -> (Vec3, f32) {
+    /// [`Self::f_pdf`] of a pair in the upper hemisphere, given T(θo) = `t_o` and the
+    /// coat's sampling probability `ps` from `wo`.
+    fn f_pdf_from(&self, t_o: f32, ps: f32, wo: Vec3, wi: Vec3) -> (Vec3, f32) {
         let base = self.diffuse_f(t_o, wi);
         let diffuse = (1.0 - ps) * cosine_hemisphere_pdf(wi.z);
         if self.is_smooth() {
             return (base, diffuse);
         }
         // The rough coat's reflection: F(ωo·ωm) D(ωm) G(ωo, ωi) / (4 cos θo cos θi).
-        let wm = sampled_wm.or_else(|| reflection_half_vector(wo, wi));
-        let (coat_f, coat_pdf) = match wm {
-            Some(wm) => {
-                let (dg, pdf) = self.distrib.reflection_about(wo, wi, wm);
-                (fresnel_dielectric(wo.dot(wm), self.eta) * dg, pdf)
-            }
+        let (coat_f, coat_pdf) = match self.distrib.reflection(wo, wi) {
+            Some((wm, dg, pdf)) => (fresnel_dielectric(wo.dot(wm), self.eta) * dg, pdf),
             None => (0.0, 0.0),
         };
         (base + self.specular * coat_f, diffuse + ps * coat_pdf)
@@ -188,22 +174,16 @@ impl Plastic {
                 flags: BsdfFlags::REFLECTION.union(BsdfFlags::DELTA),
             });
         }
-        // A coat sample keeps its normal for f and pdf (see `f_pdf_from`).
-        let (wi, sampled_wm, kind) = if coat {
-            let wm = self.distrib.sample_wm(wo, u);
-            // Seen from behind (by rounding only), the pair's half vector would be −ωm,
-            // where the coat's D is 0 and the base would answer alone: reject it instead.
-            if wo.dot(wm) <= 0.0 {
-                return None;
-            }
-            (reflect(wo, wm), Some(wm), BsdfFlags::GLOSSY)
+        let (wi, kind) = if coat {
+            let wi = reflect(wo, self.distrib.sample_wm(wo, u));
+            (wi, BsdfFlags::GLOSSY)
         } else {
-            (sample_cosine_hemisphere(u), None, BsdfFlags::DIFFUSE)
+            (sample_cosine_hemisphere(u), BsdfFlags::DIFFUSE)
         };
         if wi.z <= 0.0 {
             return None;
         }
-        let (f, pdf) = self.f_pdf_from(t_o, ps, wo, wi, sampled_wm);
+        let (f, pdf) = self.f_pdf_from(t_o, ps, wo, wi);
         (pdf > 0.0).then_some(BsdfSample {
             f,
             wi,
