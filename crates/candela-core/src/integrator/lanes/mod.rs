@@ -117,6 +117,7 @@ impl BounceLanes {
 /// Takes a band's samples with the lanes integrator; inlined into each copy of the render
 /// loop, as [`super::band::render_pixels`]. `V3`: whether this is the x86-64-v3 copy.
 #[inline(always)]
+#[allow(clippy::needless_range_loop)]
 pub(super) fn render_lanes<S: Sampler, K: SampleSink, const V3: bool>(
     scene: &Scene,
     sampler: &mut S,
@@ -215,6 +216,7 @@ pub(super) fn render_lanes<S: Sampler, K: SampleSink, const V3: bool>(
 /// traced together ([`Scene::intersect_coherent8`]; their shadow rays are then held in
 /// `shadows`, to be traced together too); else the lane traces its own rays.
 #[inline(always)]
+#[allow(clippy::too_many_arguments)]
 fn shade_lane<S: Sampler, const V3: bool>(
     scene: &Scene,
     lanes: &mut PathLanes<S>,
