@@ -187,3 +187,85 @@ fn coherent_packets_find_what_single_rays_find_bit_for_bit() {
         }
     }
 }
+
+/// Checks every ray of every packet's any-hit answer on `accel` against the single
+/// any-hit query; returns (rays asked, rays blocked).
+fn check_any(accel: &Accel, packets: &[[Ray; 8]], rng: &mut Pcg32, what: &str) -> (u32, u32) {
+    let (mut asked, mut blocked) = (0, 0);
+    for (p, rays) in packets.iter().enumerate() {
+        // Segments short and long (shadow rays towards a point) and unbounded ones
+        // (towards an infinite light).
+        let t_max: [f32; 8] = std::array::from_fn(|i| match (p + i) % 3 {
+            0 => 0.05 + 2.0 * rng.uniform_f32(),
+            1 => 0.5 * rng.uniform_f32(),
+            _ => f32::INFINITY,
+        });
+        let active = if p % 5 == 1 { 0xff >> (p % 8) } else { 0xff };
+        let found = accel.occluded_coherent8(rays, active, &t_max, mask);
+        for i in 0..8 {
+            let single = active & (1 << i) != 0
+                && accel.occluded(&rays[i], t_max[i], |prim, h| mask(i, prim, h));
+            assert_eq!(found & (1 << i) != 0, single, "{what}, packet {p}, ray {i}");
+            asked += (active >> i) & 1;
+            blocked += single as u32;
+        }
+        assert_eq!(
+            found & !active,
+            0,
+            "{what}, packet {p}: an inactive ray blocked"
+        );
+    }
+    (asked, blocked)
+}
+
+/// The any-hit packet query (`Accel::occluded_coherent8`) against eight single any-hit
+/// queries (`Accel::occluded`): every ray blocked or not as the single query says, on the
+/// scenes and packets of the closest-hit test (coherent and incoherent rays, spheres,
+/// ray-dependent alpha masks, edges aimed at, non-finite rays, partial packets), with
+/// bounded and unbounded rays, every kernel set and layout.
+#[test]
+fn any_hit_packets_answer_as_single_rays() {
+    let mut rng = Pcg32::new(35, 89);
+    let layouts = [
+        (NodeLayout::Full, LeafLayout::Inline),
+        (NodeLayout::Quantized, LeafLayout::Inline),
+        (NodeLayout::Full, LeafLayout::Indexed),
+    ];
+    // Scenes of more than a block's eight primitives that pack are one node over leaves.
+    let mut packed_roots = 0;
+    for n in [6, 8, 12, 16, 20, 40, 64, 400] {
+        let shapes = scene(&mut rng, n);
+        let packets = packets(&mut rng, &shapes, 1500);
+        let (mut asked, mut blocked, mut packed) = (0, 0, false);
+        for simd in Simd::available() {
+            for (nodes, leaves) in layouts {
+                let layout = AccelLayout { nodes, leaves };
+                let accel = Accel::build_layout(&shapes, masked, simd, layout);
+                packed |= accel.packs_rays();
+                let what = format!("{n} prims, {simd:?} {layout:?}");
+                let (a, b) = check_any(&accel, &packets, &mut rng, &what);
+                asked += a;
+                blocked += b;
+            }
+        }
+        eprintln!("{n} prims: {asked} rays, {blocked} blocked, packed {packed}");
+        // Both answers are common: short segments mostly pass, rays aimed at a
+        // primitive and unbounded ones are mostly blocked.
+        assert!(
+            blocked * 5 > asked,
+            "{n} prims: {blocked} blocked of {asked}"
+        );
+        assert!(
+            blocked * 5 < asked * 4,
+            "{n} prims: {blocked} blocked of {asked}"
+        );
+        // Trees of one leaf pack where the CPU has AVX2; so do some of one node.
+        if Simd::available().contains(&Simd::Avx2) {
+            assert!(packed || n > 8, "{n} prims: no packet query");
+            packed_roots += (packed && n > 8) as u32;
+        }
+    }
+    if Simd::available().contains(&Simd::Avx2) {
+        assert!(packed_roots > 0, "no tree of one node over leaves packs");
+    }
+}

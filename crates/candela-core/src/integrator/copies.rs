@@ -4,10 +4,8 @@
 //! inlines. The lanes integrator keeps next event estimation out of line, with a copy of
 //! its own for each; the path loop inlines it.
 
-use glam::Vec3;
-
 use super::band::{render_pixels, Band, SampleSink};
-use super::direct::{sample_direct, NeeVertex};
+use super::direct::{sample_direct, LightTerm, NeeVertex};
 use super::lanes::render_lanes;
 use super::RenderStats;
 use crate::options::{IntegratorKind, Isa};
@@ -76,7 +74,11 @@ pub(crate) fn render_band<S: Sampler, K: SampleSink>(
 /// [`sample_direct`] for the baseline target, out of line: the lanes integrator's (see
 /// `path::direct_out_of_line`).
 #[inline(never)]
-pub(super) fn sample_direct_baseline(scene: &Scene, v: &NeeVertex, rays: &mut u64) -> Vec3 {
+pub(super) fn sample_direct_baseline<T: LightTerm>(
+    scene: &Scene,
+    v: &NeeVertex,
+    rays: &mut u64,
+) -> T {
     sample_direct(scene, v, rays)
 }
 
@@ -84,7 +86,11 @@ v3_fn! {
     /// [`sample_direct`] compiled for x86-64-v3, out of line, called by the v3 copy of the
     /// lanes loop.
     #[inline(never)]
-    pub(super) fn sample_direct_v3(scene: &Scene, v: &NeeVertex, rays: &mut u64) -> Vec3 {
+    pub(super) fn sample_direct_v3<T: LightTerm>(
+        scene: &Scene,
+        v: &NeeVertex,
+        rays: &mut u64,
+    ) -> T {
         sample_direct(scene, v, rays)
     }
 }

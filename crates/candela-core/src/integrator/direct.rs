@@ -9,7 +9,7 @@ use crate::light::{Light, LightSample, LightSource, ShadingCtx};
 use crate::light_sampler::LightPick;
 use crate::options::MisMode;
 use crate::sampling::{balance_heuristic, power_heuristic};
-use crate::scene::{Scene, SurfaceInteraction};
+use crate::scene::{Scene, ShadowRay, SurfaceInteraction};
 
 /// MIS weight of a strategy with density `pdf_f` against one with density `pdf_g`.
 pub(super) fn mis_weight(mode: MisMode, pdf_f: f32, pdf_g: f32) -> f32 {
@@ -32,17 +32,59 @@ pub(super) struct NeeVertex<'a> {
     pub(super) u_point: Vec2,
 }
 
+/// What next event estimation makes of a light sample: the path integrator's
+/// contribution, its shadow ray traced at once (`Vec3`), or the lanes integrator's, its
+/// shadow ray left to trace with other paths' ([`ShadowedLight`]).
+pub(super) trait LightTerm {
+    /// Nothing to add.
+    const NONE: Self;
+    /// The term of a light sample whose shadow ray is `shadow` and which adds `value()`
+    /// where the shadow ray is unblocked.
+    fn shadowed(scene: &Scene, shadow: ShadowRay, value: impl FnOnce() -> Vec3) -> Self;
+}
+
+impl LightTerm for Vec3 {
+    const NONE: Vec3 = Vec3::ZERO;
+    #[inline(always)]
+    fn shadowed(scene: &Scene, shadow: ShadowRay, value: impl FnOnce() -> Vec3) -> Vec3 {
+        if !scene.visible(&shadow) {
+            return Vec3::ZERO;
+        }
+        value()
+    }
+}
+
+/// A light sample's contribution before its shadow ray is traced: what it adds where
+/// the shadow ray is unblocked.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct ShadowedLight {
+    pub(super) value: Vec3,
+    pub(super) shadow: ShadowRay,
+}
+
+impl LightTerm for Option<ShadowedLight> {
+    const NONE: Option<ShadowedLight> = None;
+    #[inline(always)]
+    fn shadowed(_: &Scene, shadow: ShadowRay, value: impl FnOnce() -> Vec3) -> Self {
+        Some(ShadowedLight {
+            value: value(),
+            shadow,
+        })
+    }
+}
+
 /// Next event estimation: one light picked by the light sampler, one point on it, a
-/// shadow ray, and the MIS weight against BSDF sampling of the same direction.
+/// shadow ray, and the MIS weight against BSDF sampling of the same direction; the
+/// contribution, or with the shadow ray not traced yet, as `T` says.
 #[inline(always)]
-pub(super) fn sample_direct(scene: &Scene, v: &NeeVertex, rays: &mut u64) -> Vec3 {
+pub(super) fn sample_direct<T: LightTerm>(scene: &Scene, v: &NeeVertex, rays: &mut u64) -> T {
     // The vertex's fields are read where they are used, from `v`, not copied out first:
     // copied, they lived in registers across the light sampler's call, so each was
     // stored to the stack before it and loaded back after it.
     let mode = scene.settings.mis;
     let ctx = v.ctx;
     let Some(pick) = scene.light_sampler.sample(ctx, v.u_light, &scene.lights) else {
-        return Vec3::ZERO;
+        return T::NONE;
     };
     let NeeVertex {
         si,
@@ -55,7 +97,7 @@ pub(super) fn sample_direct(scene: &Scene, v: &NeeVertex, rays: &mut u64) -> Vec
     let light = scene.light(id);
     // BSDF-only estimation still needs NEE for delta lights, which no ray can hit.
     if mode == MisMode::BsdfOnly && !light.is_delta() {
-        return Vec3::ZERO;
+        return T::NONE;
     }
     // Flat area lights, most scenes' lamps, get a copy of the rest of NEE of their own:
     // merged with the other lights' samples, which come back through memory, their sample
@@ -90,7 +132,7 @@ pub(super) fn sample_direct(scene: &Scene, v: &NeeVertex, rays: &mut u64) -> Vec
 /// The rest of [`sample_direct`], from the light's sample on: the BSDF, the shadow ray and
 /// the MIS weight.
 #[inline(always)]
-fn light_contribution(
+fn light_contribution<T: LightTerm>(
     scene: &Scene,
     si: &SurfaceInteraction,
     bsdf: &Bsdf,
@@ -98,24 +140,28 @@ fn light_contribution(
     pick: &LightPick,
     ls: Option<LightSample>,
     rays: &mut u64,
-) -> Vec3 {
+) -> T {
     let mode = scene.settings.mis;
     let Some(ls) = ls else {
-        return Vec3::ZERO;
+        return T::NONE;
     };
     let (f, bsdf_pdf) = bsdf.f_cos_pdf(wo, ls.wi);
     if f == Vec3::ZERO {
-        return Vec3::ZERO;
+        return T::NONE;
     }
     *rays += 1;
-    let visible = if ls.distance.is_finite() {
-        scene.unoccluded(si.p, si.ng, ls.p_light, ls.n_light)
+    let shadow = if ls.distance.is_finite() {
+        ShadowRay::between(si.p, si.ng, ls.p_light, ls.n_light)
     } else {
-        scene.escapes(si.p, si.ng, ls.wi)
+        ShadowRay::leaving(si.p, si.ng, ls.wi)
     };
-    if !visible {
-        return Vec3::ZERO;
-    }
+    T::shadowed(scene, shadow, || weighted(mode, pick, &ls, f, bsdf_pdf))
+}
+
+/// The contribution of light sample `ls` (of the light `pick` chose) whose BSDF value is
+/// `f` and density `bsdf_pdf`, where its shadow ray is unblocked: with its MIS weight.
+#[inline(always)]
+fn weighted(mode: MisMode, pick: &LightPick, ls: &LightSample, f: Vec3, bsdf_pdf: f32) -> Vec3 {
     // For RIS, `pick.pmf` is 1/W (the unbiased RIS weight) and `pick.mis_pmf` a tractable
     // surrogate of the pick probability; `emitter_weight` uses the same surrogate
     // (`LightSampler::pmf`), so the NEE and BSDF weights of any (light, direction) still

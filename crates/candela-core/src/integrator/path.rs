@@ -7,7 +7,9 @@ use glam::{Vec2, Vec3, Vec3A};
 use super::copies::sample_direct_baseline;
 #[cfg(target_arch = "x86_64")]
 use super::copies::sample_direct_v3;
-use super::direct::{mis_weight, sample_direct, NeeVertex};
+#[cfg(doc)]
+use super::direct::ShadowedLight;
+use super::direct::{mis_weight, sample_direct, LightTerm, NeeVertex};
 use super::volpath;
 use crate::accel::Hit;
 use crate::bsdf::Bsdf;
@@ -254,9 +256,11 @@ pub(super) fn direct<S: Sampler>(
 }
 
 /// [`direct`] out of line, in the copy of the render loop `V3` says: the lanes
-/// integrator's, whose shading of one lane at a time keeps it there.
+/// integrator's, whose shading of one lane at a time keeps it there. `T`: the
+/// contribution (`Vec3`), or with its shadow ray left to trace, where the lanes' shadow
+/// rays are traced together ([`ShadowedLight`]).
 #[inline(always)]
-pub(super) fn direct_out_of_line<S: Sampler, const V3: bool>(
+pub(super) fn direct_out_of_line<S: Sampler, const V3: bool, T: LightTerm>(
     scene: &Scene,
     si: &SurfaceInteraction,
     ctx: &ShadingCtx,
@@ -264,7 +268,7 @@ pub(super) fn direct_out_of_line<S: Sampler, const V3: bool>(
     wo: Vec3,
     u: &BounceSamples<S>,
     rays: &mut u64,
-) -> Vec3 {
+) -> T {
     let v = NeeVertex::new(si, ctx, bsdf, wo, u);
     match V3 {
         // SAFETY: only the v3 copy of the render loop has `V3`, and `render_with` asserted

@@ -1,7 +1,8 @@
-//! Camera rays eight at a time: their closest hits from one packet query of the
-//! structure ([`Accel::intersect_coherent8`]), and each hit's record made later, where
-//! the path that ray starts needs it. The same hits and records as [`Scene::intersect`]
-//! gives each ray, bit for bit.
+//! Rays eight at a time (camera packets, and the rays of the lanes integrator's eight
+//! paths): their closest hits from one packet query of the structure
+//! ([`Accel::intersect_coherent8`]), and each hit's record made later, where the path
+//! that ray starts needs it. The same hits and records as [`Scene::intersect`] gives each
+//! ray, bit for bit.
 
 use glam::Vec2;
 
@@ -12,9 +13,9 @@ use crate::accel::Hit;
 use crate::geometry::Ray;
 
 impl Scene {
-    /// Whether [`Scene::intersect_coherent8`] traces packets: the structure packs rays
-    /// ([`Accel::packs_rays`]) and the scene has no instances (their structures take
-    /// single rays).
+    /// Whether [`Scene::intersect_coherent8`] and [`Scene::occluded8`] trace packets:
+    /// the structure packs rays ([`Accel::packs_rays`]) and the scene has no instances
+    /// (their structures take single rays).
     pub fn packs_camera_rays(&self) -> bool {
         self.instances.is_empty() && self.accel.packs_rays()
     }

@@ -3,9 +3,10 @@
 //!
 //! Here the [`Scene`] and its ray queries (nearest hit, occlusion); the meshes, spheres
 //! and primitive ids in `mesh`; the hit record a query returns, and how it is made for
-//! triangles and spheres, in `interaction`.
+//! triangles and spheres, in `interaction`; shadow rays and their visibility, one at a
+//! time or eight together, in `shadow`.
 
-use glam::{Vec2, Vec3, Vec3A};
+use glam::Vec2;
 
 use crate::accel::Accel;
 use crate::camera::Camera;
@@ -15,16 +16,17 @@ use crate::instance::Instances;
 use crate::light::{Light, LightId};
 use crate::light_sampler::LightSampler;
 use crate::material::Material;
-use crate::math::offset_ray_origin_a;
 use crate::options::RenderOptions;
 
 mod coherent;
 mod interaction;
 mod mesh;
+mod shadow;
 
+use interaction::instance_triangle_interaction;
 pub use interaction::SurfaceInteraction;
-use interaction::{instance_triangle_interaction, leaving_ray, negated_unless_a};
 pub use mesh::{Mesh, Prim, ShadingRecord, Sphere};
+pub use shadow::ShadowRay;
 
 /// The scene as the integrator sees it. Made by [`crate::build::build`].
 #[derive(Clone, Debug)]
@@ -133,44 +135,5 @@ impl Scene {
         self.instances.occluded(ray, t_max, |inst, tri, hit| {
             self.instance_alpha_accepts(inst, tri, hit, ray)
         })
-    }
-
-    /// Whether the segment from surface point `from` (normal `n_from`) to point `to`
-    /// (normal `n_to`, zero for a point light) is unblocked. Both ends are moved off their
-    /// surfaces so that neither surface blocks its own ray.
-    ///
-    /// The set-up runs in SIMD lanes ([`Vec3A`]): glam's lane dot product and length sum
-    /// x, y, z in the order of [`Vec3`]'s, so the ray is the scalar code's bit for bit,
-    /// for fewer instructions (no packing into lanes and back around the two offsets,
-    /// vector subtractions and products). Inlined, so that the render loop's x86-64-v3
-    /// copy gets it compiled for v3: out of line, one baseline copy served both loops.
-    #[inline(always)]
-    pub fn unoccluded(&self, from: Vec3, n_from: Vec3, to: Vec3, n_to: Vec3) -> bool {
-        let (from, n_from) = (Vec3A::from(from), Vec3A::from(n_from));
-        let (to, n_to) = (Vec3A::from(to), Vec3A::from(n_to));
-        let d = to - from;
-        let o = offset_ray_origin_a(from, negated_unless_a(n_from, d.dot(n_from) >= 0.0));
-        let target = if n_to == Vec3A::ZERO {
-            to
-        } else {
-            offset_ray_origin_a(to, negated_unless_a(n_to, d.dot(n_to) <= 0.0))
-        };
-        let d = target - o;
-        let dist = d.length();
-        // Not 0 < dist < ∞ (NaN included): two compares, where `is_finite` was a dozen
-        // integer instructions on the bits.
-        if !(dist > 0.0 && dist < f32::INFINITY) {
-            return dist == 0.0;
-        }
-        // A relative margin keeps the far end from blocking itself.
-        let ray = Ray::new(o.into(), (d * (1.0 / dist)).into());
-        !self.occluded(&ray, dist * (1.0 - 1e-4))
-    }
-
-    /// Whether a ray leaving `from` towards `d` escapes the scene (inlined as
-    /// [`Scene::unoccluded`]).
-    #[inline(always)]
-    pub fn escapes(&self, from: Vec3, n_from: Vec3, d: Vec3) -> bool {
-        !self.occluded(&leaving_ray(from, n_from, d), f32::INFINITY)
     }
 }

@@ -171,11 +171,17 @@ impl Block {
     /// every ray of `group`, bit for bit. `filter(ray, id, hit)` is asked for filtered
     /// triangles. `PLAIN` vouches that the block holds only unfiltered triangles.
     ///
+    /// With `ANY`, any hit: a ray of `group` is marked in `best.found` where
+    /// [`Block::intersect`] with `ANY` finds a hit within its `t_max` = `best.t` (the same
+    /// test of each primitive), and is tested no further; `best`'s distances,
+    /// barycentrics and ids are then not meaningful. The block is left once every ray of
+    /// `group` is blocked.
+    ///
     /// # Safety
     /// The CPU must support AVX2.
     #[inline]
     #[target_feature(enable = "avx2,bmi1,bmi2,lzcnt")]
-    pub(crate) unsafe fn intersect_rays8<const PLAIN: bool>(
+    pub(crate) unsafe fn intersect_rays8<const PLAIN: bool, const ANY: bool>(
         &self,
         rays: &Rays8<'_>,
         group: u32,
@@ -193,10 +199,13 @@ impl Block {
             load(&rays.shear[2]),
         );
         let lane_bit = _mm256_setr_epi32(1, 2, 4, 8, 16, 32, 64, 128);
-        let in_group = _mm256_castsi256_ps(_mm256_cmpeq_epi32(
-            _mm256_and_si256(_mm256_set1_epi32(group as i32), lane_bit),
-            lane_bit,
-        ));
+        let lanes_of = |rays: u32| {
+            _mm256_castsi256_ps(_mm256_cmpeq_epi32(
+                _mm256_and_si256(_mm256_set1_epi32(rays as i32), lane_bit),
+                lane_bit,
+            ))
+        };
+        let mut in_group = lanes_of(group);
         let zero = _mm256_setzero_ps();
         // The distance range of the single-ray vector test: the ray's `t_max` on entering
         // the block.
@@ -223,6 +232,14 @@ impl Block {
             }};
         }
         for lane in 0..count as usize {
+            // A shadow ray needs one hit: the rays blocked so far are tested no further.
+            if ANY && lane > 0 {
+                let open = group & !found;
+                if open == 0 {
+                    break;
+                }
+                in_group = lanes_of(open);
+            }
             let id = self.id[lane];
             if !PLAIN && id & SPHERE != 0 {
                 let centre = [0, 1, 2].map(|axis| self.v[0][axis][lane]);
@@ -244,7 +261,7 @@ impl Block {
             }
             if !PLAIN && id & FILTERED != 0 {
                 spilled!({
-                    for r in bits(group) {
+                    for r in bits(if ANY { group & !found } else { group }) {
                         let accept = |i: u32, h: &TriangleHit| filter(r, i, h);
                         let (ray, w) = (&rays.rays[r], WatertightRay::new(&rays.rays[r]));
                         let hit = self.lane_test(ray, &w, lane, best.t[r], &accept);
@@ -317,11 +334,13 @@ impl Block {
                 );
                 let taken = _mm256_movemask_ps(take) as u32;
                 if taken != 0 {
-                    bt = _mm256_blendv_ps(bt, t, take);
-                    bb1 = _mm256_blendv_ps(bb1, _mm256_mul_ps(v, inv_det), take);
-                    bb2 = _mm256_blendv_ps(bb2, _mm256_mul_ps(ww, inv_det), take);
-                    let idv = _mm256_castsi256_ps(_mm256_set1_epi32((id & ID_MASK) as i32));
-                    bid = _mm256_blendv_ps(bid, idv, take);
+                    if !ANY {
+                        bt = _mm256_blendv_ps(bt, t, take);
+                        bb1 = _mm256_blendv_ps(bb1, _mm256_mul_ps(v, inv_det), take);
+                        bb2 = _mm256_blendv_ps(bb2, _mm256_mul_ps(ww, inv_det), take);
+                        let idv = _mm256_castsi256_ps(_mm256_set1_epi32((id & ID_MASK) as i32));
+                        bid = _mm256_blendv_ps(bid, idv, take);
+                    }
                     found |= taken;
                 }
             }

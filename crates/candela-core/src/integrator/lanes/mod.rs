@@ -6,9 +6,12 @@
 //! lane has its own sampler, positioned at its pixel sample as the path integrator's is,
 //! and draws the same dimensions in the same order (all lanes' at once where the sampler
 //! can: [`Sampler::draw_bounce_lanes`]). Each bounce runs in two stages:
-//! - per lane, scalar (`shade_lane`): the bounce's numbers, the closest hit, emission
-//!   found, the BSDF at the hit, next event estimation, and the direction of every lobe
-//!   but the Lambertian one;
+//! - per lane, scalar (`shade_lane`): the bounce's numbers, the closest hit (the busy
+//!   lanes' rays traced together before this stage where the scene packs rays:
+//!   [`Scene::intersect_coherent8`], each hit the single query's bit for bit), emission
+//!   found, the BSDF at the hit, next event estimation up to its shadow ray, and the
+//!   direction of every lobe but the Lambertian one; then, where the scene packs rays,
+//!   the lanes' shadow rays, traced together ([`shadow`]);
 //! - in lanes (`advance`): the Lambertian lobe's directions ([`diffuse`]), the throughput
 //!   update and Russian roulette, for all eight paths at once.
 //!
@@ -19,22 +22,27 @@
 //! volumetric loop ([`lanes_fallback`] says so).
 //!
 //! One concern per file: `simd` (the lane types), `state` (the paths' state in lanes),
-//! `diffuse` (the Lambertian lobe in lanes), here the bounce loop and its lane refill.
+//! `diffuse` (the Lambertian lobe in lanes), `shadow` (the lanes' shadow rays), here the
+//! bounce loop and its lane refill.
 
 mod diffuse;
+mod shadow;
 mod simd;
 mod state;
 
 use glam::{UVec2, Vec2, Vec3};
 
 use self::diffuse::DiffuseLanes;
+use self::shadow::ShadowLanes;
 #[cfg(target_arch = "x86_64")]
 use self::simd::Avx2;
 use self::simd::{F32x8, LaneIsa, Lanes32, M32x8, Portable, Vec3Lanes, Vec3x8, LANES};
 use self::state::PathLanes;
 use super::band::{camera_ray, Band, SampleSink};
+use super::direct::ShadowedLight;
 use super::path::{add_emitted, add_escaped, direct_out_of_line, hides_emitter, BounceSamples};
 use super::RenderStats;
+use crate::accel::Hit;
 use crate::bsdf::Lobe;
 use crate::light::ShadingCtx;
 use crate::options::IntegratorKind;
@@ -109,6 +117,7 @@ impl BounceLanes {
 /// Takes a band's samples with the lanes integrator; inlined into each copy of the render
 /// loop, as [`super::band::render_pixels`]. `V3`: whether this is the x86-64-v3 copy.
 #[inline(always)]
+#[allow(clippy::needless_range_loop)]
 pub(super) fn render_lanes<S: Sampler, K: SampleSink, const V3: bool>(
     scene: &Scene,
     sampler: &mut S,
@@ -140,19 +149,37 @@ pub(super) fn render_lanes<S: Sampler, K: SampleSink, const V3: bool>(
         refill(&mut lanes, i);
     }
     let mut b = BounceLanes::new();
+    // Whether the busy lanes' rays are traced together (else each lane traces its own).
+    let packs = scene.packs_camera_rays();
+    let mut traced = [None; LANES];
+    let mut shadows = ShadowLanes::new();
     while lanes.slot.iter().any(Option::is_some) {
         b.clear();
+        shadows.clear();
         // The bounce's numbers of all lanes at once where the sampler can (the independent
         // sampler in the v3 copy); idle lanes and lanes whose path ends here draw too,
         // which changes nothing: a lane's stream restarts with its next pixel sample.
         let drawn = S::draw_bounce_lanes(&mut lanes.samplers, V3);
+        if packs {
+            traced = scene.intersect_coherent8(&lanes.ray, lanes.busy());
+        }
         for i in 0..LANES {
             if lanes.slot[i].is_some() {
                 let drawn = drawn.as_ref();
-                b.shaded[i] =
-                    shade_lane::<S, V3>(scene, &mut lanes, &mut b, drawn, i, &mut stats.rays);
+                let hit = packs.then_some(traced[i]);
+                b.shaded[i] = shade_lane::<S, V3>(
+                    scene,
+                    &mut lanes,
+                    &mut b,
+                    drawn,
+                    hit,
+                    &mut shadows,
+                    i,
+                    &mut stats.rays,
+                );
             }
         }
+        shadows.finish(scene, &mut lanes.l);
         let alive = match V3 {
             #[cfg(target_arch = "x86_64")]
             true => advance::<Avx2, S>(&mut lanes, &mut b),
@@ -182,16 +209,21 @@ pub(super) fn render_lanes<S: Sampler, K: SampleSink, const V3: bool>(
 
 /// The scalar stage of lane `i`'s bounce, as the path integrator's loop body up to the
 /// throughput update: draws the bounce's numbers, traces the lane's ray, adds the emission
-/// found and next event estimation to its radiance, and leaves in `b` what the lane stage
-/// needs to continue the path. Returns whether the path scatters here (else it ends).
+/// found to its radiance, holds next event estimation's light and shadow ray in
+/// `shadows`, and leaves in `b` what the lane stage needs to continue the path. Returns whether the path scatters here (else it ends).
 /// `drawn`: the bounce's numbers of every lane, where the sampler drew them at once; else
-/// the lane draws its own.
+/// the lane draws its own. `traced`: the ray's closest hit, where the lanes' rays are
+/// traced together ([`Scene::intersect_coherent8`]; their shadow rays are then held in
+/// `shadows`, to be traced together too); else the lane traces its own rays.
 #[inline(always)]
+#[allow(clippy::too_many_arguments)]
 fn shade_lane<S: Sampler, const V3: bool>(
     scene: &Scene,
     lanes: &mut PathLanes<S>,
     b: &mut BounceLanes,
     drawn: Option<&BounceDraws<S::Deferred1d>>,
+    traced: Option<Option<Hit>>,
+    shadows: &mut ShadowLanes,
     i: usize,
     rays: &mut u64,
 ) -> bool {
@@ -216,7 +248,10 @@ fn shade_lane<S: Sampler, const V3: bool>(
         },
     );
     let ray = lanes.ray[i];
-    lanes.hit[i] = scene.intersect(&ray, f32::INFINITY);
+    lanes.hit[i] = match traced {
+        Some(hit) => scene.interaction_of(&ray, hit),
+        None => scene.intersect_for_shading(&ray, f32::INFINITY),
+    };
     let hit = lanes.hit[i].as_ref();
     if hides_emitter(scene, depth, hit) {
         return false;
@@ -258,7 +293,18 @@ fn shade_lane<S: Sampler, const V3: bool>(
         }
     };
     if !bsdf.is_delta() {
-        *l += beta * direct_out_of_line::<S, V3>(scene, si, &ctx, &bsdf, wo, &u, rays);
+        // The shadow ray held for the lanes' query where their rays are traced together,
+        // else traced at once.
+        if traced.is_some() {
+            let light: Option<ShadowedLight> =
+                direct_out_of_line::<S, V3, _>(scene, si, &ctx, &bsdf, wo, &u, rays);
+            if let Some(light) = light {
+                shadows.hold(i, beta * light.value, light.shadow);
+            }
+        } else {
+            let light: Vec3 = direct_out_of_line::<S, V3, _>(scene, si, &ctx, &bsdf, wo, &u, rays);
+            *l += beta * light;
+        }
     }
     match sampled {
         None => {}

@@ -66,6 +66,12 @@ impl<S: Clone> PathLanes<S> {
         }
     }
 
+    /// The busy lanes (bit `i` for lane `i`).
+    #[inline(always)]
+    pub fn busy(&self) -> u32 {
+        (0..LANES).fold(0, |m, i| m | (self.slot[i].is_some() as u32) << i)
+    }
+
     /// Starts lane `i` on pixel sample `slot`, of pixel `pixel`, whose camera ray through
     /// `film_pos` is `ray` (its sampler already positioned there): the state a path starts
     /// with.
