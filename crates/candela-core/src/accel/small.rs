@@ -105,22 +105,10 @@ impl SmallRoot {
         root
     }
 
-    /// The sphere lanes of leaf `lane`'s block whose boxes the box test `hits` missed:
-    /// its k-th sphere (in lane order) has its k-th box (`new` hands the free lanes out
-    /// in order). Under the AVX2 kernel (`LEAF`), `pext` gathers the missed boxes' bits and `pdep` spreads
-    /// them over the sphere lanes, two instructions for the loop over the spheres
-    /// (callgrind, spot room: about 10 instructions a block tested).
-    ///
-    /// # Safety
-    /// The CPU must support `LEAF` (and with AVX2, BMI2: [`Simd::best`] checks both).
+    /// The sphere lanes of leaf `lane`'s block whose boxes the box test `hits` missed.
     #[inline(always)]
-    unsafe fn missed_spheres<const LEAF: u8>(&self, lane: usize, hits: u32) -> u32 {
+    fn missed_spheres(&self, lane: usize, hits: u32) -> u32 {
         let (mut boxes, mut spheres) = (self.sphere_boxes[lane] as u32, self.spheres[lane] as u32);
-        #[cfg(target_arch = "x86_64")]
-        if LEAF == block::AVX2 {
-            use std::arch::x86_64::{_pdep_u32, _pext_u32};
-            return _pdep_u32(_pext_u32(!hits, boxes), spheres);
-        }
         let mut missed = 0;
         while spheres != 0 {
             let sphere = spheres & spheres.wrapping_neg();
@@ -374,7 +362,7 @@ where
         let culled = if PLAIN {
             0
         } else {
-            root.missed_spheres::<LEAF>(lane, hits)
+            root.missed_spheres(lane, hits)
         };
         // Opaque, as in the traversal: the block test's broadcasts are made where a
         // block is tested, not hoisted into the set-up and spilled.
@@ -516,8 +504,7 @@ mod tests {
             };
             (0..8)
                 .filter(|&l| root.leaves & 1 << l != 0)
-                // SAFETY: the scalar kernel runs on every CPU.
-                .map(|l| unsafe { root.missed_spheres::<{ block::SCALAR }>(l, hits) }.count_ones())
+                .map(|l| root.missed_spheres(l, hits).count_ones())
                 .sum::<u32>()
         };
         // Along -z through the first cluster's triangles, outside every sphere's box
@@ -538,54 +525,5 @@ mod tests {
         }
         let hit = accel.intersect(&at, f32::INFINITY, accept_all).unwrap();
         assert_eq!(hit.prim, 4);
-    }
-
-    /// The AVX2 kernel's `pext`/`pdep` finds the spheres the loop finds: random leaves
-    /// of up to eight spheres with their boxes in random free lanes, random box hits.
-    #[test]
-    fn missed_spheres_by_bit_deposit_as_by_the_loop() {
-        if Simd::best() != Simd::Avx2 {
-            eprintln!("no AVX2 and BMI2: nothing to compare");
-            return;
-        }
-        let mut rng = crate::sampler::Pcg32::new(35, 7);
-        let node = Node8 {
-            count: [0; 8],
-            child: [0; 8],
-            planes: [[0.0; 8]; 6],
-            leaves: 0,
-        };
-        let mut root = SmallRoot {
-            node,
-            leaves: 0,
-            sphere_boxes: [0; 8],
-            spheres: [0; 8],
-        };
-        let mut culled = 0;
-        for trial in 0..20000u32 {
-            let spheres = rng.next_u32() as u8;
-            // As many boxes as spheres, in random lanes (kept in lane order, as `new`).
-            let mut boxes = 0u8;
-            while boxes.count_ones() < spheres.count_ones() {
-                boxes |= 1 << (rng.next_u32() % 8);
-            }
-            let lane = trial as usize % 8;
-            root.sphere_boxes[lane] = boxes;
-            root.spheres[lane] = spheres;
-            let hits = rng.next_u32() & 0xff;
-            // SAFETY: `Simd::best` found AVX2 and BMI2; the scalar kernel runs anywhere.
-            let (by_bits, by_loop) = unsafe {
-                (
-                    root.missed_spheres::<{ block::AVX2 }>(lane, hits),
-                    root.missed_spheres::<{ block::SCALAR }>(lane, hits),
-                )
-            };
-            assert_eq!(
-                by_bits, by_loop,
-                "trial {trial}: {boxes:08b} {spheres:08b} {hits:08b}"
-            );
-            culled += by_loop.count_ones();
-        }
-        assert!(culled > 20000, "only {culled} culled spheres");
     }
 }
