@@ -18,7 +18,8 @@ from collections import defaultdict
 # (stage, patterns on the source path or, for library code, the function's name)
 STAGES = [
     ("traversal", ["/accel/", "/bvh/", "candela-core/src/scene/mod.rs", "instance.rs",
-                   "candela-core/src/geometry.rs",
+                   "candela-core/src/geometry.rs", "candela-core/src/scene/shadow.rs",
+                   "candela-core/src/scene/coherent.rs",
                    "candela_core::accel", "candela_core::bvh", "candela_core::scene::Scene::"]),
     ("hit record", ["scene/interaction.rs", "scene/mesh.rs", "alpha.rs",
                     "candela_core::scene::interaction"]),
