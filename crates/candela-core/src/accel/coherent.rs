@@ -41,6 +41,16 @@ impl Accel {
         false
     }
 
+    /// The blocks the packet queries test, where they trace packets
+    /// ([`Accel::packs_rays`]).
+    #[cfg(target_arch = "x86_64")]
+    fn packed_blocks(&self) -> Option<&[super::Block]> {
+        match &self.leaves {
+            super::Leaves::Inline(blocks) if self.packs_rays() => Some(blocks),
+            _ => None,
+        }
+    }
+
     /// The nearest hit of each ray `i` of `rays` that `active` names (bit `i`) within
     /// (0, `t_max[i]`), hits on flagged triangles counting only where
     /// `filter(i, prim, hit)` accepts them: what [`Accel::intersect`] finds for each, bit
@@ -53,10 +63,7 @@ impl Accel {
         filter: impl Fn(usize, u32, &TriangleHit) -> bool,
     ) -> [Option<Hit>; 8] {
         #[cfg(target_arch = "x86_64")]
-        if self.packs_rays() {
-            let super::Leaves::Inline(blocks) = &self.leaves else {
-                unreachable!("packs_rays checked the layout")
-            };
+        if let Some(blocks) = self.packed_blocks() {
             // SAFETY: `finish` checked that the CPU supports AVX2 (and with it BMI1,
             // BMI2 and LZCNT, which `Simd::best` asks for).
             return unsafe {
@@ -87,10 +94,7 @@ impl Accel {
         filter: impl Fn(usize, u32, &TriangleHit) -> bool,
     ) -> u32 {
         #[cfg(target_arch = "x86_64")]
-        if self.packs_rays() {
-            let super::Leaves::Inline(blocks) = &self.leaves else {
-                unreachable!("packs_rays checked the layout")
-            };
+        if let Some(blocks) = self.packed_blocks() {
             // SAFETY: as in `intersect_coherent8`.
             return unsafe {
                 if self.plain {
